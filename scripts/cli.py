@@ -1,0 +1,211 @@
+"""`cpgbiped`: the command-line front end. Parses, calls the library, prints; no logic of its own.
+
+Every user error becomes one line on stderr ("cpgbiped: error: ...") and exit status 2.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import textwrap
+
+# MuJoCo reads MUJOCO_GL when it is imported: set it once, before anything imports it.
+os.environ.setdefault("MUJOCO_GL", "osmesa")
+if os.environ.get("PYOPENGL_PLATFORM") not in (None, os.environ["MUJOCO_GL"]):
+    os.environ["PYOPENGL_PLATFORM"] = os.environ["MUJOCO_GL"]
+
+DESCRIPTION = """\
+cpgbiped takes a central pattern generator (CPG) from equations to a walking, running,
+jumping and hopping planar biped in MuJoCo, with numbers that show the gait is real.
+
+The heart is the 4-cell Morris-Lecar network of Farshbaf Rashidi, Sayyed Noorani and
+Shoaran (2016): cells LF, RF, LE, RE (left/right ankle flexor/extensor) coupled by the
+weights w_a (left-right), w_b (flexor-extensor) and w_c (diagonal). Time in the CPG is in
+dimensionless model units; physics is in seconds.
+"""
+
+EPILOG = """\
+examples:
+  cpgbiped demo                          the main job: everything below, summarised in out/demo
+  cpgbiped reproduce                     the paper's four gaits from its Table 2 weights
+  cpgbiped reproduce --json --plot       machine-readable, plus a PNG like Figs. 3-6
+  cpgbiped matsuoka                      what the printed 12-neuron network does, and the calibration
+  cpgbiped hopf --gait walk              the Hopf network's version of a gait
+
+Outputs go under out/ unless told otherwise. Exit status: 0 ok, 2 bad input, 130 interrupted.
+"""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2
+        raise SystemExit(_fail(f"{message} (see '{self.prog} --help')"))
+
+
+def _fail(msg: str) -> int:
+    print(f"cpgbiped: error: {msg}", file=sys.stderr)
+    return 2
+
+
+def _fmt_table(rows: list[list[str]], header: list[str]) -> str:
+    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
+    line = lambda r: "  ".join(str(c).rjust(w) for c, w in zip(r, widths))  # noqa: E731
+    return "\n".join([line(header), line(["-" * w for w in widths])] + [line(r) for r in rows])
+
+
+# ---------------------------------------------------------------------------------- reproduce
+def cmd_reproduce(a) -> int:
+    from cpg import io, morris_lecar as ml
+    from cpg.reproduce import reproduce
+
+    results = reproduce(dt=a.dt)
+    summary = {g: r.summary() for g, r in results.items()}
+    if a.plot:
+        from cpg.plots import plot_gait_signals
+
+        panels = {g: (r.trajectory.t, r.trajectory.x[0],
+                      f"I_app={ml.PRESETS[g].i_app}, phi={ml.PRESETS[g].phi}, "
+                      f"(w_a, w_b, w_c)={ml.PRESETS[g].weights}")
+                  for g, r in results.items()}
+        path = plot_gait_signals(panels, os.path.join(a.out, "reproduce_signals.png"))
+        if not a.json:
+            print(f"wrote {path}")
+    if a.json:
+        print(io.to_json(summary))
+        return 0
+    rows = []
+    for g, s in summary.items():
+        ph = s["phases_deg"]
+        rows.append([g, f"{s['period']:.3f}", *(f"{ph[c]:.2f}" for c in ("RF", "LE", "RE")),
+                     "yes" if s["waveforms_equal"] else "no", s["classified_as"]])
+    print("Paper's Table 2 presets from Table 3 states (phases of RF, LE, RE vs LF, degrees):")
+    print(_fmt_table(rows, ["gait", "period", "RF", "LE", "RE", "same wave", "classified"]))
+    return 0
+
+
+# ----------------------------------------------------------------------------------- matsuoka
+def cmd_matsuoka(a) -> int:
+    from dataclasses import replace
+
+    from cpg import io, matsuoka as mt
+
+    sets = {"printed": mt.PRINTED, "calibrated": mt.CALIBRATED}
+    out = {}
+    for name, p in sets.items():
+        for label, q in ((f"{name}, noise-free", replace(p, L=0.0)),
+                         (f"{name}, noise L={p.L}", p)):
+            rep = mt.rhythm_report(q, seconds=150.0 if name == "printed" else 40.0, seed=a.seed)
+            out[label] = {"tau": q.tau, "T": q.T, "r": q.r, "L": q.L,
+                          "oscillating": rep.oscillating, "frequency_hz": rep.frequency_hz,
+                          "pair_frequency_hz": dict(zip(mt.JOINTS, rep.pair_frequency_hz)),
+                          "lr_phase_deg": dict(zip(("hip", "knee", "ankle"), rep.lr_phase_deg))}
+    if a.json:
+        print(io.to_json(out))
+        return 0
+    rows = [[k, f"{v['tau']:.4g}", f"{v['T']:.4g}", f"{v['r']:g}",
+             f"{v['frequency_hz']:.4f}",
+             " ".join(f"{f:.3f}" for f in v["pair_frequency_hz"].values()),
+             " ".join(f"{p:.1f}" for p in v["lr_phase_deg"].values())] for k, v in out.items()]
+    print("Matsuoka 12-neuron network (joint pair = extensor - flexor drive):")
+    print(_fmt_table(rows, ["parameter set", "tau s", "T s", "r", "freq Hz",
+                            "pair rates Hz (L hip..R ankle)", "L/R phase hip knee ankle"]))
+    return 0
+
+
+# --------------------------------------------------------------------------------------- hopf
+def cmd_hopf(a) -> int:
+    from cpg import hopf, io
+    from cpg.gaits import classify
+
+    p = hopf.HopfParams(beta=a.beta, normalised=a.normalised)
+    tr = hopf.primary_gait(a.gait, p, t_end=a.seconds, dt=1e-3, t_record=a.seconds / 2,
+                           record_every=2, seed=a.seed)
+    name, r = classify(tr.t, tr.x[0])
+    out = {"gait": a.gait, "period_s": r.period, "expected_period_s": p.period,
+           "phases_deg": dict(zip(("RF", "LE", "RE"), r.phases_deg[1:])),
+           "classified_as": name}
+    print(io.to_json(out, indent=2 if a.json else None) if a.json else
+          "\n".join(f"{k}: {io.to_json(v, indent=None)}" for k, v in out.items()))
+    return 0
+
+
+# --------------------------------------------------------------------------------------- demo
+def cmd_demo(a) -> int:
+    from cpg import io
+
+    out = io.ensure_dir(a.out)
+    print("== 1/2  the paper's four gaits in the 4-cell Morris-Lecar network")
+    ns = argparse.Namespace(dt=0.02, plot=True, json=False, out=str(out))
+    cmd_reproduce(ns)
+    print("\n== 2/2  the 12-neuron Matsuoka network: printed vs calibrated")
+    cmd_matsuoka(argparse.Namespace(json=False, seed=0))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="cpgbiped", description=DESCRIPTION, epilog=EPILOG,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+
+    def add(name, func, help_, desc):
+        sp = sub.add_parser(name, help=help_, description=textwrap.dedent(desc),
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+        sp.set_defaults(func=func)
+        return sp
+
+    sp = add("demo", cmd_demo, "run the main job and summarise it in out/demo",
+             "Run the product end to end with its defaults and write the results under --out.")
+    sp.add_argument("--out", default="out/demo", help="output folder (default: out/demo)")
+
+    sp = add("reproduce", cmd_reproduce, "the paper's four gaits from its Table 2 weights", """\
+        Simulate the 4-cell network for walk, run, jump and hop with the paper's Table 2
+        (I_app, phi, w_a, w_b, w_c) from its Table 3 initial states for 500 model time units,
+        analyse the second half and print: the period (model time units), the phases of RF,
+        LE, RE behind LF (degrees, [0, 360)), whether all four waveforms are equal, and the
+        gait the classifier names. Targets: walk 180/180/0, run 180/0/180, jump 0/180/180,
+        hop 0/0/0.""")
+    sp.add_argument("--json", action="store_true", help="print one JSON object keyed by gait")
+    sp.add_argument("--plot", action="store_true",
+                    help="write the steady-state signals (PNG) to --out")
+    sp.add_argument("--out", default="out", help="folder for --plot (default: out)")
+    sp.add_argument("--dt", type=float, default=0.02, help="RK4 step, model units (default 0.02)")
+
+    sp = add("matsuoka", cmd_matsuoka, "the 12-neuron Matsuoka network: printed vs calibrated",
+             """\
+        Measure what the printed Matsuoka parameters produce (frequency, the repetition rate
+        of each joint's extensor-minus-flexor drive, left/right phase) with and without the
+        paper's white noise (L = 1.5), next to the calibrated preset that reaches the claimed
+        1 Hz. See cpg/matsuoka.py for the calibration and why.""")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+    sp.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+
+    sp = add("hopf", cmd_hopf, "a primary gait in the Hopf network", """\
+        Four Hopf oscillators (LF, RF, LE, RE) with stance/swing asymmetry and rotation
+        coupling set to a primary gait's phase lags, from a random state; prints the period
+        (seconds) and the phases the analysis measures.""")
+    sp.add_argument("--gait", default="walk", help="walk, run, jump or hop (default walk)")
+    sp.add_argument("--beta", type=float, default=0.6, help="duty factor in (0, 1)")
+    sp.add_argument("--normalised", action="store_true", help="normalised coupling variant")
+    sp.add_argument("--seconds", type=float, default=20.0, help="simulated seconds")
+    sp.add_argument("--seed", type=int, default=0)
+    sp.add_argument("--json", action="store_true")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    from cpg.errors import InputError
+
+    try:
+        args = build_parser().parse_args(argv)
+        return int(args.func(args) or 0)
+    except SystemExit as e:
+        return e.code if isinstance(e.code, int) else 0
+    except InputError as e:
+        return _fail(str(e))
+    except KeyboardInterrupt:
+        print("cpgbiped: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
