@@ -6,7 +6,8 @@ Two paths share one result type:
 - :func:`simulate_ml` integrates the 4-cell Morris–Lecar network with a compiled RK4 kernel
   (numba, parallel over the batch); the hot path of the optimiser and the benchmark.
 
-A member whose state becomes non-finite (or exceeds ``BLOWUP``) is frozen at NaN from then on
+A member whose state becomes non-finite (or exceeds ``BLOWUP``; ``ML_RANGE`` for the
+Morris–Lecar kernel) is frozen at NaN from then on
 and flagged in ``Trajectory.diverged``; the other members are unaffected. Nothing raises.
 
 Accuracy: RK4 at the default step ``DT_ML = 0.02`` model units keeps the steady-state phases of
@@ -23,8 +24,13 @@ import numpy as np
 from . import morris_lecar as ml
 from .errors import InputError
 
-BLOWUP = 1e6  # |state| above this counts as divergence
+BLOWUP = 1e6  # |state| above this counts as divergence (generic integrator)
 DT_ML = 0.02  # default step (model units) of the Morris–Lecar kernel
+# Morris–Lecar: every orbit of the cell keeps u in [0, 1] and v in about [-0.5, 0.5]. Strong
+# negative coupling can push v beyond the cell's range, where lam(v) = cosh((v - V3)/(2 V4))
+# makes the u-equation stiff (rate ~1e4 at v = 3) and the solution runs away. Leaving
+# |state| <= ML_RANGE counts as divergence, for this kernel and for the reference solvers.
+ML_RANGE = 1.5
 
 
 @dataclass
@@ -63,8 +69,11 @@ def _check_timing(t_end: float, dt: float, t_record: float, record_every: int) -
 
 def rk4(f: Callable[[float, np.ndarray, int], np.ndarray], y0: np.ndarray, t_end: float,
         dt: float, t_record: float = 0.0, record_every: int = 1,
-        output: Callable[[np.ndarray], np.ndarray] | None = None) -> Trajectory:
-    """Classic RK4 on a batch y0 (B, D); ``output(y)`` picks what to record (default: y)."""
+        output: Callable[[np.ndarray], np.ndarray] | None = None,
+        bound: float = BLOWUP) -> Trajectory:
+    """Classic RK4 on a batch y0 (B, D); ``output(y)`` picks what to record (default: y).
+
+    A member with a non-finite state or |state| >= ``bound`` counts as diverged."""
     n_steps, rec_start = _check_timing(t_end, dt, t_record, record_every)
     y = np.array(y0, dtype=float)
     if y.ndim != 2:
@@ -91,7 +100,7 @@ def rk4(f: Callable[[float, np.ndarray, int], np.ndarray], y0: np.ndarray, t_end
         k4 = f(t + dt, y + dt * k3, s)
         with np.errstate(invalid="ignore", over="ignore"):
             y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-            bad = ~np.all(np.isfinite(y) & (np.abs(y) < BLOWUP), axis=1) & ~diverged
+            bad = ~np.all(np.abs(y) < bound, axis=1) & ~diverged  # NaN fails too
         if bad.any():
             diverged |= bad
             t_div[bad] = (s + 1) * dt
@@ -121,7 +130,8 @@ try:  # the compiled kernel; NumPy fallback keeps the package usable without num
                          - ml.G_L * (v - ml.V_L) + i_app - coup)
 
     @numba.njit(cache=True, parallel=True)
-    def _ml_kernel(y0, i_app, phi, W, dt, n_steps, rec_start, rec_every, out, final, div_step):
+    def _ml_kernel(y0, i_app, phi, W, dt, n_steps, rec_start, rec_every, bound, out, final,
+                   div_step):
         B = y0.shape[0]
         n_rec = out.shape[1]
         for b in numba.prange(B):
@@ -157,7 +167,7 @@ try:  # the compiled kernel; NumPy fallback keeps the package usable without num
                 ok = True
                 for k in range(8):
                     y[k] += dt / 6.0 * (k1[k] + 2.0 * k2[k] + 2.0 * k3[k] + k4[k])
-                    if not (abs(y[k]) < 1e6):  # also catches NaN
+                    if not (abs(y[k]) < bound):  # also catches NaN
                         ok = False
                 if not ok:
                     div_step[b] = s + 1
@@ -190,7 +200,7 @@ def simulate_ml(i_app, phi, W, y0, t_end: float = 500.0, dt: float = DT_ML,
         raise InputError(f"unknown backend {backend!r}: use auto, numba or numpy")
     if backend == "numpy" or (backend == "auto" and not HAVE_NUMBA):
         return rk4(lambda t, y, s: ml.rhs(y, i_app, phi, W), y0, t_end, dt, t_record,
-                   record_every, output=lambda y: y[:, ml.N_CELLS:])
+                   record_every, output=lambda y: y[:, ml.N_CELLS:], bound=ML_RANGE)
     if not HAVE_NUMBA:
         raise InputError("backend 'numba' asked for, but numba is not installed")
     B = y0.shape[0]
@@ -198,8 +208,8 @@ def simulate_ml(i_app, phi, W, y0, t_end: float = 500.0, dt: float = DT_ML,
     out = np.empty((B, len(rec), ml.N_CELLS))
     final = np.empty((B, 2 * ml.N_CELLS))
     div_step = np.zeros(B, dtype=np.int64)
-    _ml_kernel(y0, i_app, phi, W, float(dt), n_steps, rec_start, int(record_every), out, final,
-               div_step)
+    _ml_kernel(y0, i_app, phi, W, float(dt), n_steps, rec_start, int(record_every), ML_RANGE,
+               out, final, div_step)
     diverged = div_step > 0
     t_div = np.where(diverged, div_step * dt, np.nan)
     return Trajectory(rec * dt, out, final, diverged, t_div)

@@ -1,0 +1,316 @@
+"""NSGA-II (pymoo) search of coupling weights: primary gaits and symmetry-breaking searches.
+
+- :class:`PrimaryGaitProblem`: variables (w_a, w_b, w_c) in a box, the gait's (I_app, phi)
+  from Table 2, objectives z1..z3 (phase errors of RF, LE, RE vs LF, degrees), one
+  constraint (oscillating, locked, equal waveforms). The whole population is integrated in
+  one batched call (vectorised ``_evaluate``).
+- :class:`SymmetryBreakingProblem`: from a primary gait's optimum, perturbations of the 12
+  directed weights that keep exactly one reflection of the square network (the H symmetry
+  the target needs) and break the other two; objectives from the target's row of the gait
+  table (see :mod:`cpg.evaluate`).
+- :func:`run`: NSGA-II with checkpoints (the pickled algorithm holds pymoo's random
+  generator, so a resumed run continues bit for bit) and an optional Dask evaluator.
+
+Reflections of the square (cells LF, RF / LE, RE; flexors on top): "vertical" swaps left and
+right (LF<->RF, LE<->RE), "horizontal" swaps flexor and extensor (LF<->LE, RF<->RE),
+"diagonal" swaps LF<->RE and RF<->LE.
+"""
+from __future__ import annotations
+
+import pickle
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from pymoo.core.problem import Problem
+
+from . import morris_lecar as ml
+from .errors import InputError
+from .evaluate import Evaluation, SimSettings, evaluate
+from .gaits import GAITS, PRIMARY, gait as gait_entry
+from .io import atomic_path
+
+REFLECTIONS = {
+    "vertical": (1, 0, 3, 2),
+    "horizontal": (2, 3, 0, 1),
+    "diagonal": (3, 2, 1, 0),
+}
+
+# Secondary targets: (target, source primary gait, kept reflection, reached by the paper).
+# The kept reflection is the target's H symmetry; the two hops that the table lists without
+# one keep the symmetry their identical cells need (asymmetric hop: LF = RE, RF = LE ->
+# diagonal; one-legged hop: LF = LE, RF = RE -> horizontal).
+SECONDARY_TARGETS = (
+    ("skip", "walk", "vertical", True),
+    ("skip", "run", "vertical", True),
+    ("gallop", "walk", "horizontal", True),
+    ("hesitation_walk", "jump", "diagonal", True),
+    ("gallop", "jump", "horizontal", False),
+    ("hesitation_walk", "run", "diagonal", False),
+    ("asymmetric_hop", "hop", "diagonal", False),
+    ("one_legged_hop", "hop", "horizontal", False),
+)
+
+
+def orbits(keep: str) -> list[list[int]]:
+    """Groups of the 12 directed weights (indices into ``ml.DIRECTED``) that a weight matrix
+    invariant under reflection ``keep`` must hold equal: W[s(j), s(i)] = W[j, i]."""
+    s = REFLECTIONS[keep]
+    index = {pair: k for k, pair in enumerate(ml.DIRECTED)}
+    seen, out = set(), []
+    for k, (j, i) in enumerate(ml.DIRECTED):
+        if k in seen:
+            continue
+        group = sorted({k, index[(s[j], s[i])]})
+        seen.update(group)
+        out.append(group)
+    return out
+
+
+def check_bounds(lo: float, hi: float) -> None:
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        raise InputError(f"bounds must be finite, got [{lo}, {hi}]")
+    if not lo < hi:
+        raise InputError(f"empty or inverted bounds [{lo}, {hi}]: the lower must be below the upper")
+
+
+class _BatchedProblem(Problem):
+    """Shared vectorised evaluation; an optional evaluator (e.g. Dask) takes the batch."""
+
+    gait: str
+    i_app: float
+    phi: float
+    y0: np.ndarray
+    settings: SimSettings
+
+    def __init__(self, n_var, lo, hi, evaluator=None):
+        check_bounds(lo, hi)
+        super().__init__(n_var=n_var, n_obj=3, n_ieq_constr=1, xl=np.full(n_var, lo),
+                         xu=np.full(n_var, hi))
+        self.evaluator = evaluator
+        self.last: Evaluation | None = None
+
+    def matrices(self, X: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        W = self.matrices(np.asarray(X, dtype=float))
+        if self.evaluator is None:
+            ev = evaluate(self.gait, self.i_app, self.phi, W, self.y0, self.settings)
+        else:
+            ev = self.evaluator(self.gait, self.i_app, self.phi, W, self.y0, self.settings)
+        self.last = ev
+        out["F"] = ev.F
+        out["G"] = ev.G[:, None]
+
+    def __getstate__(self):  # checkpoints never hold a live cluster connection
+        state = self.__dict__.copy()
+        state["evaluator"] = None
+        state["last"] = None
+        return state
+
+
+class PrimaryGaitProblem(_BatchedProblem):
+    """Variables (w_a, w_b, w_c) in [lo, hi]^3 for a primary gait (Table 2 I_app, phi)."""
+
+    def __init__(self, gait: str, lo: float = -1.0, hi: float = 1.0,
+                 settings: SimSettings = SimSettings(), evaluator=None):
+        g = gait_entry(gait)
+        if not g.primary:
+            raise InputError(f"{g.name} is a secondary gait: search it by symmetry breaking")
+        p = ml.preset(g.name)
+        self.gait, self.i_app, self.phi, self.y0 = g.name, p.i_app, p.phi, p.y0
+        self.settings = settings
+        super().__init__(3, lo, hi, evaluator)
+
+    def matrices(self, X):
+        return ml.weight_matrix(X)
+
+
+class SymmetryBreakingProblem(_BatchedProblem):
+    """Perturbations d of a base network that keep one reflection: W = W_base + expand(d).
+
+    Variables: one value per orbit of directed weights under the kept reflection, in
+    [-radius, radius]. The base network is the source gait's weights with its (I_app, phi).
+    """
+
+    def __init__(self, target: str, source: str, keep: str, base_weights, radius: float = 1.0,
+                 settings: SimSettings = SimSettings(), evaluator=None):
+        g = gait_entry(target)
+        if g.primary:
+            raise InputError(f"{g.name} is a primary gait: use the primary search")
+        if keep not in REFLECTIONS:
+            raise InputError(f"unknown reflection {keep!r}: use {', '.join(REFLECTIONS)}")
+        p = ml.preset(source)
+        self.gait, self.source, self.keep = g.name, source, keep
+        self.i_app, self.phi, self.y0 = p.i_app, p.phi, p.y0
+        self.base = ml.weight_matrix(np.asarray(base_weights, dtype=float))
+        self.groups = orbits(keep)
+        self.settings = settings
+        super().__init__(len(self.groups), -radius, radius, evaluator)
+
+    def directed(self, X: np.ndarray) -> np.ndarray:
+        """The 12 directed weights (B, 12) of perturbations X (B, n_orbits)."""
+        X = np.atleast_2d(X)
+        w12 = np.repeat(ml.directed_vector(self.base)[None], X.shape[0], axis=0)
+        for k, group in enumerate(self.groups):
+            w12[:, group] += X[:, [k]]
+        return w12
+
+    def matrices(self, X):
+        return ml.directed_matrix(self.directed(X))
+
+
+# ------------------------------------------------------------------------- Dask evaluation
+def _evaluate_chunk(args):
+    gait, i_app, phi, W, y0, settings = args
+    ev = evaluate(gait, i_app, phi, W, y0, settings)
+    return ev
+
+
+class DaskEvaluator:
+    """Evaluate population chunks on a Dask cluster (a LocalCluster when no address)."""
+
+    def __init__(self, address: str | None = None, n_chunks: int | None = None,
+                 n_workers: int = 2):
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:  # pragma: no cover - pinned dependency
+            raise InputError("dask.distributed is not installed") from None
+        if address is not None and not str(address).startswith("tcp://"):
+            raise InputError(f"Dask scheduler address must look like tcp://host:port, got {address!r}")
+        self.cluster = None
+        try:
+            if address is None:
+                self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1,
+                                            processes=True, dashboard_address=None)
+                self.client = Client(self.cluster)
+            else:
+                self.client = Client(address, timeout="10s")
+        except OSError as e:
+            raise InputError(f"cannot reach the Dask scheduler {address!r}: {e}") from None
+        self.n_chunks = n_chunks or max(1, len(self.client.scheduler_info().get("workers", {})))
+
+    def __call__(self, gait, i_app, phi, W, y0, settings) -> Evaluation:
+        chunks = np.array_split(np.arange(W.shape[0]), self.n_chunks)
+        y0 = np.broadcast_to(y0, (W.shape[0], y0.shape[-1]))
+        futures = self.client.map(_evaluate_chunk,
+                                  [(gait, i_app, phi, W[c], y0[c], settings) for c in chunks if len(c)],
+                                  pure=False)
+        parts = self.client.gather(futures)
+        return Evaluation(np.concatenate([p.F for p in parts]), np.concatenate([p.G for p in parts]),
+                          sum((p.reasons for p in parts), []), sum((p.classified for p in parts), []),
+                          np.concatenate([p.phases_deg for p in parts]))
+
+    def close(self):
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+# ---------------------------------------------------------------------------------- runner
+@dataclass
+class RunSettings:
+    pop: int = 40
+    gens: int = 30
+    seed: int = 0
+    checkpoint_every: int = 5
+
+    def __post_init__(self):
+        if int(self.pop) < 4:
+            raise InputError(f"population must be at least 4, got {self.pop}")
+        if int(self.gens) < 1:
+            raise InputError(f"generations must be at least 1, got {self.gens}")
+        if int(self.checkpoint_every) < 1:
+            raise InputError(f"checkpoint interval must be at least 1, got {self.checkpoint_every}")
+
+
+@dataclass
+class RunResult:
+    X: np.ndarray  # final population (P, n_var)
+    F: np.ndarray
+    G: np.ndarray
+    pareto_X: np.ndarray
+    pareto_F: np.ndarray
+    n_gen: int
+    resumed_from: int | None = None
+    history: list = field(default_factory=list)
+
+
+def _algorithm(pop: int):
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+
+    return NSGA2(pop_size=int(pop), eliminate_duplicates=True)
+
+
+def save_checkpoint(path: Path, algorithm, meta: dict) -> None:
+    with atomic_path(path, suffix=".tmp") as tmp:
+        with open(tmp, "wb") as f:
+            pickle.dump({"format": "cpgbiped.checkpoint/1", "meta": meta, "algorithm": algorithm}, f)
+
+
+def load_checkpoint(path: Path, meta: dict):
+    try:
+        with open(path, "rb") as f:
+            blob = pickle.load(f)
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as e:
+        raise InputError(f"unreadable checkpoint {str(path)!r}: {e}") from None
+    if not isinstance(blob, dict) or blob.get("format") != "cpgbiped.checkpoint/1":
+        raise InputError(f"unreadable checkpoint {str(path)!r}: not a cpgbiped checkpoint")
+    if blob["meta"] != meta:
+        raise InputError(f"checkpoint {str(path)!r} belongs to another run "
+                         f"({blob['meta']}); delete it or use the same settings")
+    return blob["algorithm"]
+
+
+def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None = None,
+        on_generation: Callable[[int, int], None] | None = None,
+        stop_after: int | None = None) -> RunResult:
+    """NSGA-II on ``problem``; checkpoints every ``rs.checkpoint_every`` generations.
+
+    With an existing checkpoint of the same problem and settings the run resumes from it.
+    ``stop_after`` stops after that many generations of this call (to test resuming).
+    """
+    meta = {"problem": type(problem).__name__, "gait": problem.gait, "n_var": problem.n_var,
+            "xl": problem.xl.tolist(), "xu": problem.xu.tolist(), **asdict(rs),
+            "settings": asdict(problem.settings)}
+    meta.pop("checkpoint_every")
+    ckpt = Path(checkpoint) if checkpoint else None
+    resumed = None
+    if ckpt is not None and ckpt.exists():
+        algorithm = load_checkpoint(ckpt, meta)
+        algorithm.problem = problem  # re-attach the evaluator (never pickled)
+        resumed = algorithm.n_gen - 1 if algorithm.n_gen else 0
+    else:
+        algorithm = _algorithm(rs.pop)
+        algorithm.setup(problem, termination=("n_gen", int(rs.gens)), seed=int(rs.seed),
+                        verbose=False)
+    done_here = 0
+    while algorithm.has_next():
+        algorithm.next()
+        gen = algorithm.n_gen - 1
+        done_here += 1
+        if on_generation:
+            on_generation(gen, int(rs.gens))
+        if ckpt is not None and (gen % rs.checkpoint_every == 0 or not algorithm.has_next()):
+            save_checkpoint(ckpt, algorithm, meta)
+        if stop_after is not None and done_here >= stop_after and algorithm.has_next():
+            raise KeyboardInterrupt
+    pop = algorithm.pop
+    opt = algorithm.opt
+    return RunResult(pop.get("X"), pop.get("F"), pop.get("G"), opt.get("X"), opt.get("F"),
+                     algorithm.n_gen - 1, resumed)
+
+
+def primary_names(gait: str) -> list[str]:
+    """Expand "all" to the four primary gaits; a clear error for unknown names."""
+    if gait == "all":
+        return list(PRIMARY)
+    return [gait_entry(gait).name] if gait_entry(gait).primary else _not_primary(gait)
+
+
+def _not_primary(gait):
+    raise InputError(f"{gait!r} is not a primary gait: optimize takes {', '.join(PRIMARY)} or all"
+                     f" (secondary gaits: {', '.join(n for n in GAITS if n not in PRIMARY)} via"
+                     f" 'cpgbiped secondary')")

@@ -1,0 +1,236 @@
+"""Drive the NSGA-II searches and write their results (JSON, CSV, PNG, Markdown), atomically.
+
+Result file ``<gait>.json`` (format "cpgbiped.optimize/1"): ``chosen`` {weights, errors_deg,
+robustness}, ``pareto`` (list of the same), ``paper`` (Table 2 weights evaluated the same
+way), ``settings`` and ``i_app``/``phi``. The chosen point has the smallest total error
+among the final population (within 0.01 degree counts as a tie), ties broken by robustness
+(fraction of random initial states that reach the gait).
+"""
+from __future__ import annotations
+
+import csv
+import io as _io
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import morris_lecar as ml
+from .errors import InputError
+from .evaluate import SimSettings, evaluate, robustness
+from .io import atomic_path, ensure_dir, write_json, write_text
+from .optimize import (SECONDARY_TARGETS, PrimaryGaitProblem, RunSettings,
+                       SymmetryBreakingProblem, run)
+
+FORMAT = "cpgbiped.optimize/1"
+SECONDARY_FORMAT = "cpgbiped.secondary/1"
+TIE_DEG = 0.01
+N_TIE_CANDIDATES = 8
+
+
+def _csv(path: Path, header: list[str], rows) -> None:
+    buf = _io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(header)
+    for r in rows:
+        w.writerow(r)
+    write_text(path, buf.getvalue())
+
+
+def _plot_front(path: Path, F_pop: np.ndarray, F_opt: np.ndarray, title: str, names) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    for ax, (a, b) in zip(axes, ((0, 1), (0, 2), (1, 2))):
+        ax.scatter(F_pop[:, a], F_pop[:, b], s=10, c="0.7", label="final population")
+        ax.scatter(F_opt[:, a], F_opt[:, b], s=18, c="tab:red", label="Pareto set")
+        ax.set_xscale("symlog", linthresh=1e-3)
+        ax.set_yscale("symlog", linthresh=1e-3)
+        ax.set_xlabel(f"{names[a]} (deg)")
+        ax.set_ylabel(f"{names[b]} (deg)")
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+
+
+def choose(X: np.ndarray, F: np.ndarray, robust_fn) -> tuple[int, np.ndarray]:
+    """Index of the chosen point among feasible points (X, F) and the robustness of the
+    candidates examined (NaN elsewhere).
+
+    Candidates are the points whose total error is within ``TIE_DEG`` of the best: with a
+    symmetric network many weight sets hit the targets exactly, and those differ only in how
+    many initial states lead to the gait. Up to ``N_TIE_CANDIDATES`` of them, spread over
+    weight space, are scored by ``robust_fn``; the most robust wins.
+    """
+    total = F.sum(axis=1)
+    ties = np.nonzero(total <= total.min() + TIE_DEG)[0]
+    if len(ties) > N_TIE_CANDIDATES:  # spread: every k-th along the first principal axis
+        Xc = X[ties] - X[ties].mean(axis=0)
+        axis = np.linalg.svd(Xc, full_matrices=False)[2][0]
+        order = ties[np.argsort(Xc @ axis, kind="stable")]
+        ties = order[np.linspace(0, len(order) - 1, N_TIE_CANDIDATES).round().astype(int)]
+    rob = np.full(len(X), np.nan)
+    rob[ties] = robust_fn(X[ties])
+    best = max(ties, key=lambda k: (rob[k], -total[k]))
+    return int(best), rob
+
+
+def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1.0,
+                     hi: float = 1.0, settings: SimSettings = SimSettings(), evaluator=None,
+                     progress=None, n_robust: int = 50, stop_after: int | None = None) -> dict:
+    """Run NSGA-II for one primary gait; write DIR/<gait>.json, CSVs and the front PNG."""
+    out = ensure_dir(out)
+    problem = PrimaryGaitProblem(gait, lo, hi, settings, evaluator)
+    t0 = time.perf_counter()
+    res = run(problem, rs, checkpoint=out / f".{gait}.checkpoint.pkl", on_generation=progress,
+              stop_after=stop_after)
+    ok = res.pareto_X
+    F_opt = res.pareto_F
+    feasible = res.G[:, 0] <= 0
+    if not feasible.any():
+        raise InputError(f"no feasible solution for {gait}: widen the bounds or the budget")
+    rob_fn = lambda X: robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(X),  # noqa: E731
+                                  n_states=20, seed=rs.seed + 1)
+    Xf, Ff = res.X[feasible], res.F[feasible]
+    k, rob_pop = choose(Xf, Ff, rob_fn)
+    chosen_x, chosen_f = Xf[k], Ff[k]
+    rob = np.array([rob_pop[np.nonzero(np.all(Xf == x, axis=1))[0][0]]
+                    if np.any(np.all(Xf == x, axis=1)) else np.nan for x in ok])
+    rob_best = float(robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(chosen_x),
+                                n_states=n_robust, seed=rs.seed + 2)[0])
+    paper_w = np.array(ml.preset(gait).weights)
+    ev_paper = evaluate(gait, problem.i_app, problem.phi, ml.weight_matrix(paper_w[None]),
+                        problem.y0, settings)
+    rob_paper = float(robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(paper_w),
+                                 n_states=n_robust, seed=rs.seed + 2)[0])
+    wall = time.perf_counter() - t0
+    point = lambda x, f, r: {"weights": np.round(x, 6).tolist(),  # noqa: E731
+                             "errors_deg": np.round(f, 6).tolist(),
+                             "robustness": None if not np.isfinite(r) else float(r)}
+    result = {
+        "format": FORMAT, "gait": gait, "i_app": problem.i_app, "phi": problem.phi,
+        "settings": {"pop": rs.pop, "gens": rs.gens, "seed": rs.seed, "bounds": [lo, hi],
+                     "sim": settings.__dict__, "robustness_states": n_robust},
+        "chosen": point(chosen_x, chosen_f, rob_best),
+        "pareto": [point(x, f, r) for x, f, r in zip(ok, F_opt, rob)],
+        "paper": point(paper_w, ev_paper.F[0], rob_paper),
+        "n_generations": res.n_gen, "resumed_from_generation": res.resumed_from,
+        "wall_s": round(wall, 3),
+    }
+    # The final population with the reason each member passed or failed.
+    ev = evaluate(gait, problem.i_app, problem.phi, ml.weight_matrix(res.X), problem.y0, settings)
+    head = ["w_a", "w_b", "w_c", "z_RF", "z_LE", "z_RE", "constraint", "status", "classified"]
+    _csv(out / f"{gait}_population.csv", head,
+         [[*np.round(x, 6), *np.round(f, 6), round(float(g), 6), r, c]
+          for x, f, g, r, c in zip(res.X, ev.F, ev.G, ev.reasons, ev.classified)])
+    _csv(out / f"{gait}_pareto.csv", ["w_a", "w_b", "w_c", "z_RF", "z_LE", "z_RE", "robustness"],
+         [[*np.round(x, 6), *np.round(f, 6), "" if not np.isfinite(r) else r]
+          for x, f, r in zip(ok, F_opt, rob)])
+    _plot_front(out / f"{gait}_pareto.png", res.F, F_opt,
+                f"{gait}: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed {rs.seed}",
+                ("z_RF", "z_LE", "z_RE"))
+    write_json(out / f"{gait}.json", result)
+    (out / f".{gait}.checkpoint.pkl").unlink(missing_ok=True)
+    return result
+
+
+def load_result(path: str | Path) -> dict:
+    """A primary-gait result file, validated; clear errors for anything else."""
+    import json
+
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text())
+    except FileNotFoundError:
+        raise InputError(f"result file {str(p)!r} does not exist") from None
+    except (OSError, ValueError) as e:
+        raise InputError(f"result file {str(p)!r} is not readable JSON: {e}") from None
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"{str(p)!r} is not a cpgbiped optimiser result (format {FORMAT})")
+    try:
+        w = np.array(data["chosen"]["weights"], dtype=float)
+        pareto = [np.array(q["weights"], dtype=float) for q in data["pareto"]]
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"{str(p)!r} lacks chosen/pareto weights") from None
+    for v in [w] + pareto:
+        if v.shape != (3,) or not np.all(np.isfinite(v)):
+            raise InputError(f"{str(p)!r} holds weights that are not three finite numbers")
+    return data
+
+
+# ------------------------------------------------------------------------------ secondary
+def secondary_search(target: str, source: str, keep: str, base_weights, rs: RunSettings,
+                     settings: SimSettings = SimSettings(), radius: float = 1.0,
+                     evaluator=None, progress=None, n_confirm: int = 10) -> dict:
+    """Search one symmetry-breaking target; confirm the best point with the classifier."""
+    problem = SymmetryBreakingProblem(target, source, keep, base_weights, radius, settings,
+                                      evaluator)
+    res = run(problem, rs, on_generation=progress)
+    F = res.pareto_F
+    best = int(np.argmin(F.sum(axis=1)))
+    w12 = problem.directed(res.pareto_X[best])[0]
+    W = ml.directed_matrix(w12)
+    y0 = np.vstack([problem.y0, ml.random_states(n_confirm, rs.seed + 3)])
+    ev = evaluate(target, problem.i_app, problem.phi, np.repeat(W[None], len(y0), 0), y0, settings)
+    confirmed = float(np.mean([c == target for c in ev.classified]))
+    return {
+        "target": target, "source": source, "kept_symmetry": keep,
+        "i_app": problem.i_app, "phi": problem.phi,
+        "base_weights": list(map(float, base_weights)),
+        "directed_weights": dict(zip(ml.DIRECTED_NAMES, np.round(w12, 6).tolist())),
+        "objectives": np.round(F[best], 4).tolist(),
+        "objective_names": ["phase error of same-wave pairs (deg)",
+                            "180 x waveform distance of same-wave pairs",
+                            "180 x shortfall of distinctness of y1/y2 pairs"],
+        "classified_from_table3_state": ev.classified[0],
+        "confirmed_fraction": confirmed,
+        "found": bool(ev.classified[0] == target and confirmed >= 0.8),
+    }
+
+
+def secondary_all(primary_weights: dict[str, list[float]], rs: RunSettings,
+                  settings: SimSettings = SimSettings(), evaluator=None, progress=None,
+                  targets=SECONDARY_TARGETS) -> list[dict]:
+    out = []
+    for target, source, keep, paper in targets:
+        r = secondary_search(target, source, keep, primary_weights[source], rs, settings,
+                             evaluator=evaluator, progress=progress)
+        r["paper_reached"] = paper
+        out.append(r)
+    return out
+
+
+def comparison_markdown(primary: dict[str, dict], secondary: list[dict] | None) -> str:
+    """The comparison table: the paper's Table 2 vs ours; secondary targets reached or not."""
+    f = lambda v: ", ".join(f"{x:.3f}" for x in v)  # noqa: E731
+    lines = ["## Primary gaits: the paper's Table 2 weights vs NSGA-II here", "",
+             "| gait | paper (w_a, w_b, w_c) | paper errors (deg) | paper robustness | "
+             "ours (w_a, w_b, w_c) | our errors (deg) | our robustness |",
+             "|---|---|---|---|---|---|---|"]
+    for g, r in primary.items():
+        p, c = r["paper"], r["chosen"]
+        lines.append(f"| {g} | {f(p['weights'])} | {f(p['errors_deg'])} | {p['robustness']:.2f} "
+                     f"| {f(c['weights'])} | {f(c['errors_deg'])} | {c['robustness']:.2f} |")
+    lines += ["", "Robustness: fraction of random initial states that reach the gait "
+              "(every phase error < 2 deg, classifier agrees)."]
+    if secondary:
+        lines += ["", "## Secondary gaits by symmetry breaking", "",
+                  "| target | from | kept symmetry | paper reached | found here | confirmed "
+                  "from random states | objectives |", "|---|---|---|---|---|---|---|"]
+        for s in secondary:
+            lines.append(f"| {s['target']} | {s['source']} | {s['kept_symmetry']} | "
+                         f"{'yes' if s['paper_reached'] else 'no'} | "
+                         f"{'yes' if s['found'] else 'no'} | {s['confirmed_fraction']:.0%} | "
+                         f"{f(s['objectives'])} |")
+    return "\n".join(lines) + "\n"
+
+
+def write_secondary(out: str | Path, results: list[dict]) -> Path:
+    return write_json(Path(out) / "secondary.json", {"format": SECONDARY_FORMAT,
+                                                     "targets": results})
