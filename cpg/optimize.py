@@ -213,7 +213,7 @@ class DaskEvaluator:
 @dataclass
 class RunSettings:
     pop: int = 40
-    gens: int = 30
+    gens: int = 25
     seed: int = 0
     checkpoint_every: int = 5
 

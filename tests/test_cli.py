@@ -50,3 +50,34 @@ def test_bad_input_one_line_nonzero(args, msg):
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("cpgbiped: error:") and msg in lines[0]
     assert "Traceback" not in r.stderr
+
+
+def test_optimize_small_run(tmp_path):
+    r = run("optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--quiet",
+            "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    data = json.loads((tmp_path / "hop.json").read_text())
+    assert len(data["chosen"]["weights"]) == 3 and len(data["chosen"]["errors_deg"]) == 3
+    assert data["pareto"] and data["format"] == "cpgbiped.optimize/1"
+
+
+@pytest.mark.parametrize("args,msg", [
+    (["--gait", "trot"], "unknown gait"),
+    (["--gait", "skip"], "not a primary gait"),
+    (["--bounds", "1", "-1"], "inverted"),
+    (["--pop", "2"], "at least 4"),
+    (["--gens", "0"], "at least 1"),
+])
+def test_optimize_bad_input_writes_nothing(tmp_path, args, msg):
+    out = tmp_path / "o"
+    r = run("optimize", *args, "--quiet", "--out", str(out))
+    assert r.returncode == 2 and msg in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_optimize_unreadable_checkpoint(tmp_path):
+    (tmp_path / ".hop.checkpoint.pkl").write_bytes(b"garbage")
+    r = run("optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--quiet",
+            "--out", str(tmp_path))
+    assert r.returncode == 2 and "unreadable checkpoint" in r.stderr
+    assert not (tmp_path / "hop.json").exists()
