@@ -1,0 +1,150 @@
+"""Gait measurement from recorded foot-contact series: pure functions, no physics, no CPG.
+
+Input: times t (T,) in seconds on a uniform grid and raw contact booleans (T, 2) for the
+left and right foot. Contact flickers for a few milliseconds around impacts, so every run of
+contact or no-contact shorter than ``min_phase_s`` is merged into its neighbours first.
+
+Definitions (over the analysis window, after the settling period):
+- touchdown / lift-off: rising / falling edges of the debounced contact of a foot;
+- stride period: mean interval between successive touchdowns of a foot (both feet pooled);
+- duty factor of a foot: fraction of the time in contact;
+- left-right lag: for each left touchdown, (next right touchdown - it) / stride period,
+  circular mean as a fraction of a stride in [0, 1); 0.5 = alternating, 0 = together;
+- double support / flight: fraction of the time with both / neither foot in contact;
+- distance, mean speed: centre-of-mass x travelled and divided by the window length.
+Physical gait (from these numbers alone):
+- "none" when fallen, or fewer than 3 touchdowns per foot;
+- two-legged (|lag| within ``SYNC_TOL`` of 0 or 1) with flight >= 10%: "hop" when the mean
+  duty factor is below ``HOP_DUTY``, else "jump";
+- alternating (lag within 0.5 +- ``ALT_TOL``): "walk" when flight < 2%, double support > 5%
+  and duty >= 0.5 on both feet; "run" when flight >= 10% and duty < 0.5 on both feet;
+- otherwise "none".
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+MIN_PHASE_S = 0.03
+SYNC_TOL = 0.1
+ALT_TOL = 0.15
+HOP_DUTY = 0.45
+
+
+def debounce(contact: np.ndarray, dt: float, min_phase_s: float = MIN_PHASE_S) -> np.ndarray:
+    """Merge runs (of either value) shorter than ``min_phase_s`` into their neighbours."""
+    c = np.asarray(contact, dtype=bool).copy()
+    n_min = max(1, int(round(min_phase_s / dt)))
+    if len(c) < 2:
+        return c
+    changed = True
+    while changed:
+        changed = False
+        edges = np.flatnonzero(np.diff(c.astype(np.int8))) + 1
+        starts = np.concatenate([[0], edges])
+        ends = np.concatenate([edges, [len(c)]])
+        lengths = ends - starts
+        # Interior runs only: the first and last runs may be cut by the window.
+        short = [k for k in range(1, len(starts) - 1) if lengths[k] < n_min]
+        if short:
+            k = min(short, key=lambda k: lengths[k])
+            c[starts[k]:ends[k]] = ~c[starts[k]]
+            changed = True
+    return c
+
+
+def edges(t: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(touchdown times, lift-off times) of a debounced contact series."""
+    d = np.diff(c.astype(np.int8))
+    return t[1:][d == 1], t[1:][d == -1]
+
+
+@dataclass
+class GaitMetrics:
+    fell: bool
+    fell_at_s: float | None
+    duty_factor: dict
+    lr_phase_lag: float
+    double_support: float
+    flight: float
+    stride_period_s: float
+    distance_m: float
+    speed_mps: float
+    touchdowns: dict
+    liftoffs: dict
+    physical_gait: str
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def lr_lag(td_left: np.ndarray, td_right: np.ndarray, period: float) -> float:
+    """Circular mean of (next right touchdown - left touchdown) / period, in [0, 1)."""
+    if len(td_left) == 0 or len(td_right) == 0 or not np.isfinite(period) or period <= 0:
+        return float("nan")
+    lags = []
+    for tl in td_left:
+        later = td_right[td_right >= tl]
+        if len(later):
+            lags.append(((later[0] - tl) / period) % 1.0)
+    if not lags:
+        return float("nan")
+    ang = 2 * np.pi * np.array(lags)
+    return float((np.angle(np.mean(np.exp(1j * ang))) / (2 * np.pi)) % 1.0)
+
+
+def classify_physical(m: GaitMetrics) -> str:
+    if m.fell or min(len(m.touchdowns["left"]), len(m.touchdowns["right"])) < 3:
+        return "none"
+    lag = m.lr_phase_lag
+    if not np.isfinite(lag):
+        return "none"
+    duty = np.array([m.duty_factor["left"], m.duty_factor["right"]])
+    if min(lag, 1.0 - lag) <= SYNC_TOL:
+        if m.flight >= 0.10:
+            return "hop" if duty.mean() < HOP_DUTY else "jump"
+        return "none"
+    if abs(lag - 0.5) <= ALT_TOL:
+        if m.flight < 0.02 and m.double_support > 0.05 and np.all(duty >= 0.5):
+            return "walk"
+        if m.flight >= 0.10 and np.all(duty < 0.5):
+            return "run"
+    return "none"
+
+
+def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: float | None = None,
+            settle_s: float = 0.0, min_phase_s: float = MIN_PHASE_S) -> GaitMetrics:
+    """All metrics of a rollout; only samples at t >= settle_s count (fall: any time)."""
+    t = np.asarray(t, dtype=float)
+    contact = np.asarray(contact, dtype=bool)
+    com_x = np.asarray(com_x, dtype=float)
+    if len(t) < 2:
+        c = np.zeros((0, 2), bool)
+        return GaitMetrics(fell_at is not None, fell_at, {"left": float("nan"), "right": float("nan")},
+                           float("nan"), float("nan"), float("nan"), float("nan"), 0.0, 0.0,
+                           {"left": [], "right": []}, {"left": [], "right": []}, "none")
+    dt = float(np.median(np.diff(t)))
+    sel = t >= settle_s
+    ts = t[sel]
+    cs = np.stack([debounce(contact[:, i], dt, min_phase_s) for i in range(2)], axis=1)[sel]
+    td, lo = {}, {}
+    for i, leg in enumerate(("left", "right")):
+        td[leg], lo[leg] = edges(ts, cs[:, i]) if len(ts) > 1 else (np.empty(0), np.empty(0))
+    strides = np.concatenate([np.diff(td["left"]), np.diff(td["right"])])
+    period = float(np.mean(strides)) if len(strides) else float("nan")
+    window = float(ts[-1] - ts[0]) if len(ts) > 1 else 0.0
+    distance = float(com_x[sel][-1] - com_x[sel][0]) if sel.sum() > 1 else 0.0
+    m = GaitMetrics(
+        fell=fell_at is not None, fell_at_s=fell_at,
+        duty_factor={"left": float(cs[:, 0].mean()) if len(cs) else float("nan"),
+                     "right": float(cs[:, 1].mean()) if len(cs) else float("nan")},
+        lr_phase_lag=lr_lag(td["left"], td["right"], period),
+        double_support=float(cs.all(axis=1).mean()) if len(cs) else float("nan"),
+        flight=float((~cs.any(axis=1)).mean()) if len(cs) else float("nan"),
+        stride_period_s=period, distance_m=distance,
+        speed_mps=distance / window if window > 0 else 0.0,
+        touchdowns={k: v.tolist() for k, v in td.items()},
+        liftoffs={k: v.tolist() for k, v in lo.items()}, physical_gait="none")
+    m.physical_gait = classify_physical(m)
+    return m

@@ -1,0 +1,216 @@
+"""Off-screen rendering of recorded rollouts to video (mediapy) and pictures.
+
+Backend: ``MUJOCO_GL`` (osmesa by default, egl accepted) is read when MuJoCo is imported; the
+CLI and ``envs/__init__`` set it first. :func:`check_backend` turns a backend that cannot start
+into one line naming the library and the Debian package to install.
+Frames are taken by simulated time (``fps`` per simulated second, from the recorded qpos),
+not per physics step. Shadows, reflections and the skybox are off unless asked for (about
+5x faster with Mesa's software renderer). Feet are marked by a sphere coloured by stance
+(green on the ground, grey in the air).
+"""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from cpg.errors import InputError
+from cpg.io import atomic_path
+
+BACKENDS = {"osmesa": ("libOSMesa", "libosmesa6"), "egl": ("libEGL", "libegl1")}
+
+
+def check_backend() -> str:
+    """The GL backend in use; InputError naming the missing library and apt package."""
+    gl = os.environ.get("MUJOCO_GL", "osmesa")
+    if gl not in BACKENDS and gl not in ("glfw",):
+        raise InputError(f"unsupported MUJOCO_GL={gl!r}: use osmesa (default) or egl")
+    try:
+        import mujoco
+
+        with mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8):
+            pass
+    except Exception as e:  # noqa: BLE001 - any backend failure is reported in one line
+        lib, pkg = BACKENDS.get(gl, ("an X display", "xvfb"))
+        raise InputError(f"off-screen rendering with MUJOCO_GL={gl} failed ({type(e).__name__}): "
+                         f"{lib} is missing or unusable; install it with 'apt-get install -y "
+                         f"{pkg}'") from None
+    return gl
+
+
+def _ffmpeg():
+    import mediapy
+
+    if shutil.which("ffmpeg") is None:
+        import imageio_ffmpeg
+
+        mediapy.set_ffmpeg(imageio_ffmpeg.get_ffmpeg_exe())
+    return mediapy
+
+
+def check_video_size(width: int, height: int, fps: float, seconds: float) -> None:
+    if width <= 0 or height <= 0:
+        raise InputError(f"video size must be positive, got {width}x{height}")
+    if width % 2 or height % 2:
+        raise InputError(f"video size {width}x{height} is odd: yuv420p video needs even width "
+                         f"and height")
+    if not (np.isfinite(fps) and fps > 0):
+        raise InputError(f"fps must be positive, got {fps}")
+    if not (np.isfinite(seconds) and seconds > 0):
+        raise InputError(f"seconds must be positive, got {seconds}")
+
+
+class FrameRenderer:
+    """Renders qpos states of the biped scene with a side camera tracking the torso."""
+
+    def __init__(self, width: int = 640, height: int = 480, fancy: bool = False,
+                 xml_path=None):
+        import mujoco
+
+        from models import BIPED_SCENE
+
+        self.mujoco = mujoco
+        check_backend()
+        self.model = mujoco.MjModel.from_xml_path(str(xml_path or BIPED_SCENE))
+        self.model.vis.global_.offwidth = max(self.model.vis.global_.offwidth, width)
+        self.model.vis.global_.offheight = max(self.model.vis.global_.offheight, height)
+        self.data = mujoco.MjData(self.model)
+        self.renderer = mujoco.Renderer(self.model, height, width)
+        self.cam = mujoco.MjvCamera()
+        self.cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+        self.cam.distance, self.cam.elevation, self.cam.azimuth = 3.0, -8.0, 90.0
+        self.fancy = fancy
+        self.foot_ids = [self.model.body("left_foot").id, self.model.body("right_foot").id]
+
+    def frame(self, qpos: np.ndarray, stance=None) -> np.ndarray:
+        mj = self.mujoco
+        self.data.qpos[:] = qpos
+        mj.mj_forward(self.model, self.data)
+        torso = self.data.xpos[self.model.body("torso").id]
+        self.cam.lookat[:] = [torso[0], 0.0, 0.6]
+        self.renderer.update_scene(self.data, self.cam)
+        scn = self.renderer.scene
+        if not self.fancy:
+            for flag in (mj.mjtRndFlag.mjRND_SHADOW, mj.mjtRndFlag.mjRND_REFLECTION,
+                         mj.mjtRndFlag.mjRND_SKYBOX):
+                scn.flags[flag] = 0
+        if stance is not None:
+            for leg, body in enumerate(self.foot_ids):
+                if scn.ngeom >= scn.maxgeom:
+                    break
+                pos = self.data.xpos[body] + np.array([0.0, 0.0, -0.05])
+                rgba = [0.1, 0.9, 0.2, 1] if stance[leg] else [0.6, 0.6, 0.6, 0.8]
+                mj.mjv_initGeom(scn.geoms[scn.ngeom], mj.mjtGeom.mjGEOM_SPHERE,
+                                np.array([0.035, 0, 0]), pos, np.eye(3).ravel(),
+                                np.array(rgba, dtype=np.float32))
+                scn.ngeom += 1
+        return self.renderer.render().copy()
+
+    def close(self):
+        self.renderer.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def frame_indices(t: np.ndarray, fps: float, seconds: float) -> np.ndarray:
+    """Sample index for each video frame k at simulated time k / fps (frames = seconds x fps)."""
+    n = int(round(seconds * fps))
+    times = np.arange(n) / fps
+    return np.clip(np.searchsorted(t, times + 1e-9), 0, len(t) - 1)
+
+
+def _signal_strip(rec, k: int, width: int, height: int) -> np.ndarray:
+    """A small plot of the four CPG outputs (last 2 s up to sample k) as an RGB image."""
+    img = np.full((height, width, 3), 255, np.uint8)
+    lo = max(0, k - int(2.0 / rec.dt))
+    seg = rec.cpg_v[lo:k + 1]
+    if len(seg) < 2:
+        return img
+    colors = [(31, 119, 180), (214, 39, 40), (23, 190, 207), (255, 127, 14)]
+    vmin, vmax = float(np.min(rec.cpg_v)), float(np.max(rec.cpg_v))
+    band = height / 4
+    xs = np.linspace(0, width - 1, int(2.0 / rec.dt) + 1)[-len(seg):].astype(int)
+    for c in range(4):
+        ys = (c * band + band * (1 - (seg[:, c] - vmin) / max(vmax - vmin, 1e-9)) * 0.9).astype(int)
+        ys = np.clip(ys, 0, height - 1)
+        for x0, x1, y0, y1 in zip(xs[:-1], xs[1:], ys[:-1], ys[1:]):
+            n = max(abs(x1 - x0), abs(y1 - y0), 1)
+            img[np.linspace(y0, y1, n + 1).astype(int), np.linspace(x0, x1, n + 1).astype(int)] = colors[c]
+    return img
+
+
+def render_video(rec, path: str | Path, fps: float = 30.0, width: int = 640, height: int = 480,
+                 seconds: float | None = None, signals: bool = True, fancy: bool = False) -> Path:
+    """Write an mp4 of a recording with qpos (``rollout(..., record_qpos=True)``)."""
+    seconds = float(rec.t[-1]) if seconds is None else seconds
+    check_video_size(width, height, fps, seconds)
+    if rec.qpos.size == 0:
+        raise InputError("the recording holds no states to render (record_qpos=False)")
+    idx = frame_indices(rec.t - rec.t[0] + rec.dt, fps, seconds)
+    strip_h = (height // 5) & ~1 if signals else 0
+    mediapy = _ffmpeg()
+    with FrameRenderer(width, height - strip_h, fancy) as fr:
+        frames = []
+        for k in idx:
+            f = fr.frame(rec.qpos[k], rec.contact[k])
+            if signals:
+                f = np.concatenate([f, _signal_strip(rec, k, width, strip_h)], axis=0)
+            frames.append(f)
+    with atomic_path(path, suffix=".mp4") as tmp:
+        mediapy.write_video(str(tmp), frames, fps=fps, codec="h264")
+    return Path(path)
+
+
+def gait_diagram(rec, path: str | Path, metrics=None, title: str = "") -> Path:
+    """Footfall bars per foot over time (the locomotion literature's gait diagram), PNG."""
+    from cpg.plots import _plt
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(9, 1.9))
+    for row, (leg, color) in enumerate((("left", "tab:blue"), ("right", "tab:red"))):
+        c = rec.contact[:, row]
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], c.astype(int), [0]])))
+        for s, e in zip(edges[::2], edges[1::2]):
+            ax.broken_barh([(rec.t[s], rec.t[min(e, len(rec.t) - 1)] - rec.t[s])], (1 - row, 0.8),
+                           color=color)
+    ax.set_yticks([1.4, 0.4], ["left", "right"])
+    ax.set_xlabel("time (s)")
+    sub = f" - physical: {metrics.physical_gait}" if metrics is not None else ""
+    ax.set_title(f"{title}{sub}", fontsize=10, loc="left")
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+    return Path(path)
+
+
+def signals_picture(rec, path: str | Path, title: str = "") -> Path:
+    """CPG outputs, ankle activations and joint angles of a rollout, PNG."""
+    from cpg.plots import _plt
+
+    plt = _plt()
+    fig, axes = plt.subplots(3, 1, figsize=(9, 6), sharex=True)
+    names = ("LF", "RF", "LE", "RE")
+    for c in range(4):
+        axes[0].plot(rec.t, rec.cpg_v[:, c], label=names[c], lw=1)
+        axes[1].plot(rec.t, rec.activation[:, c], label=names[c], lw=1)
+    for j, n in enumerate(("L hip", "L knee", "L ankle", "R hip", "R knee", "R ankle")):
+        axes[2].plot(rec.t, rec.joints[:, j], label=n, lw=1)
+    axes[0].set_ylabel("CPG v")
+    axes[1].set_ylabel("activation")
+    axes[2].set_ylabel("angle (rad)")
+    axes[2].set_xlabel("time (s)")
+    for ax in axes:
+        ax.legend(loc="upper right", fontsize=7, ncol=6, frameon=False)
+    axes[0].set_title(title, fontsize=10, loc="left")
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+    return Path(path)

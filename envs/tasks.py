@@ -1,0 +1,108 @@
+"""dm_control tasks: the CPG drives the biped; an agent may add a residual to the controls.
+
+``envs.load(name, **options)`` mirrors ``suite.load``: tasks "walk", "run", "jump", "hop" use
+the paper's Table 2 network and the controller preset of that gait; "free" takes a weights
+file (optimiser result JSON) and a gait whose (I_app, phi) and controller preset it uses.
+Action: 8 values in [-1, 1] added to the CPG controller's output (ankle muscles LF, RF, LE,
+RE then hips and knees) and clipped to the actuator ranges; a zero action is the pure CPG.
+Reward: upright (torso pitch within 0.3 rad, height above 0.7 m) times forward speed within
+the gait's target band (dm_control ``rewards.tolerance``).
+"""
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+from dm_control.rl import control
+from dm_control.suite import base
+from dm_control.utils import rewards
+
+from cpg import morris_lecar as ml
+from cpg.errors import InputError
+
+from .biped import Physics, load_physics
+from .controller import GAIT_CONTROL, CPGController, ControlParams, cpg_schedule, preset_network
+
+TARGET_SPEED = {"walk": 0.5, "run": 1.5, "jump": 0.3, "hop": 0.3}
+CONTROL_TIMESTEP = 0.01  # s (5 physics steps of 2 ms)
+DEFAULT_TIME_LIMIT = 20.0  # s
+
+
+class CPGLocomotion(base.Task):
+    """A primary gait driven by the 4-cell CPG; all randomness from ``random``."""
+
+    def __init__(self, gait: str, network, params: ControlParams, random=None,
+                 random_cpg_state: bool = False, friction_scale: float = 1.0):
+        super().__init__(random=random)
+        self.gait, self.network, self.params = gait, network, params
+        self.random_cpg_state = random_cpg_state
+        self.friction_scale = friction_scale
+        self.controller: CPGController | None = None
+        self._residual = np.zeros(8)
+
+    def initialize_episode(self, physics: Physics):
+        if self.friction_scale != 1.0 and not getattr(physics, "_friction_scaled", False):
+            physics.scale_friction(self.friction_scale)
+            physics._friction_scaled = True
+        i_app, phi, W, y0 = self.network
+        if self.random_cpg_state:
+            y0 = ml.random_states(1, self.random)[0]
+        sched = cpg_schedule(i_app, phi, W, y0, self.params.time_scale * 120.0)
+        self.controller = CPGController(physics, sched, self.params)
+        super().initialize_episode(physics)
+
+    def before_step(self, action, physics: Physics):
+        self._residual = np.asarray(action, dtype=float)
+        u = self.controller(physics.data.time) + self._residual
+        lo, hi = physics.model.actuator_ctrlrange.T
+        physics.set_control(np.clip(u, lo, hi))
+
+    def action_spec(self, physics):
+        from dm_env import specs
+
+        return specs.BoundedArray((8,), np.float64, -np.ones(8), np.ones(8), name="residual")
+
+    def get_observation(self, physics: Physics):
+        obs = collections.OrderedDict()
+        obs["joint_angles"] = physics.joint_angles()
+        obs["torso_height"] = np.array([physics.torso_height()])
+        obs["torso_pitch"] = np.array([physics.torso_pitch()])
+        obs["com_velocity"] = np.array([physics.com_velocity_x()])
+        obs["foot_forces"] = physics.foot_forces()
+        c = self.controller
+        obs["cpg"] = np.array(c.last_v) if c is not None else np.zeros(4)
+        obs["muscle_activation"] = np.array(physics.data.act[:4])
+        return obs
+
+    def get_reward(self, physics: Physics):
+        upright = rewards.tolerance(physics.torso_pitch(), bounds=(-0.3, 0.3), margin=0.7)
+        standing = rewards.tolerance(physics.torso_height(), bounds=(0.7, 2.0), margin=0.3)
+        target = TARGET_SPEED.get(self.gait, 0.5)
+        move = rewards.tolerance(physics.com_velocity_x(), bounds=(target, float("inf")),
+                                 margin=target, value_at_margin=0.5, sigmoid="linear")
+        return float(upright * standing * (1 + 5 * move) / 6)
+
+
+def load(name: str, weights: str | None = None, gait: str | None = None,
+         time_limit: float = DEFAULT_TIME_LIMIT, random=None, random_cpg_state: bool = False,
+         friction_scale: float = 1.0, xml_path=None) -> control.Environment:
+    """An environment like ``suite.load``: walk, run, jump, hop, or free (with ``weights``)."""
+    if name == "free":
+        if weights is None:
+            raise InputError("task 'free' needs a weights file (an optimiser result JSON)")
+        from cpg.search import load_result
+
+        data = load_result(weights)
+        gait = gait or data["gait"]
+        p = ml.preset(gait)
+        network = (p.i_app, p.phi, ml.weight_matrix(np.array(data["chosen"]["weights"])), p.y0)
+    elif name in GAIT_CONTROL:
+        gait = name
+        network = preset_network(name)
+    else:
+        raise InputError(f"unknown task {name!r}: use walk, run, jump, hop or free")
+    physics = load_physics(xml_path) if xml_path else load_physics()
+    task = CPGLocomotion(gait, network, GAIT_CONTROL[gait], random=random,
+                         random_cpg_state=random_cpg_state, friction_scale=friction_scale)
+    return control.Environment(physics, task, time_limit=time_limit,
+                               control_timestep=CONTROL_TIMESTEP)

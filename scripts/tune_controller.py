@@ -1,0 +1,86 @@
+"""Tune the balance/pattern-formation gains of one gait's controller with pymoo's GA.
+
+The CPG (rhythm, leg timing) stays the paper's Table 2 network; only the controller gains in
+``envs.controller.ControlParams`` are searched. Fitness (minimised) follows the acceptance
+criteria of the physical gaits (envs.gait_metrics): a fall costs 100 minus the seconds
+survived; otherwise the shortfalls from the gait's targets (left-right lag, duty factor,
+double support, flight, forward distance) are summed. Prints the best gains as Python.
+
+    python scripts/tune_controller.py walk [--pop 24] [--gens 15] [--seconds 12]
+"""
+from __future__ import annotations
+
+import argparse
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+SPACE = dict(ankle_gain=(0.03, 0.7), push=(0.0, 0.7), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
+             c_d=(0.0, 0.8), kp_t=(1.0, 6.0), kd_t=(0.1, 0.8), knee_swing=(-1.4, -0.3),
+             time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0))
+KEYS = list(SPACE)
+
+
+def cost(gait: str, m, seconds: float) -> float:
+    if m.fell:
+        return 100.0 - (m.fell_at_s or 0.0)
+    duty = np.array([m.duty_factor["left"], m.duty_factor["right"]])
+    lag = m.lr_phase_lag if np.isfinite(m.lr_phase_lag) else 0.25
+    sync = min(lag, 1 - lag)
+    d = m.distance_m
+    if gait == "walk":
+        c = 4 * abs(lag - 0.5) + 4 * np.maximum(0, 0.58 - duty).sum() + \
+            4 * max(0, 0.07 - m.double_support) + 8 * m.flight + max(0, 0.25 * seconds - d)
+    elif gait == "run":
+        c = 4 * abs(lag - 0.5) + 4 * np.maximum(0, duty - 0.45).sum() + \
+            4 * max(0, 0.14 - m.flight) + max(0, 0.35 * seconds - d)
+    elif gait == "jump":
+        c = 4 * sync + 4 * max(0, 0.14 - m.flight) + 4 * max(0, 0.5 - duty.mean()) + \
+            max(0, 0.0 - d) * 0.2
+    else:
+        c = 4 * sync + 4 * max(0, 0.2 - m.flight) + 4 * max(0, duty.mean() - 0.40) + \
+            max(0, 0.0 - d) * 0.2
+    return float(c + (0 if m.physical_gait == gait else 1.0))
+
+
+def evaluate(args):
+    gait, x, seconds = args
+    from envs.biped import rollout
+    from envs.controller import GAIT_CONTROL, preset_network, with_params
+    from envs.gait_metrics import measure
+
+    p = with_params(GAIT_CONTROL[gait], **dict(zip(KEYS, map(float, x))))
+    r = rollout(preset_network(gait), p, seconds)
+    return cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds)
+
+
+def main(argv=None):
+    from pymoo.algorithms.soo.nonconvex.ga import GA
+    from pymoo.core.problem import Problem
+    from pymoo.optimize import minimize
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("gait")
+    ap.add_argument("--pop", type=int, default=24)
+    ap.add_argument("--gens", type=int, default=15)
+    ap.add_argument("--seconds", type=float, default=12.0)
+    ap.add_argument("--seed", type=int, default=0)
+    a = ap.parse_args(argv)
+    lo = np.array([SPACE[k][0] for k in KEYS])
+    hi = np.array([SPACE[k][1] for k in KEYS])
+    pool = ProcessPoolExecutor(2)
+
+    class Tune(Problem):
+        def __init__(self):
+            super().__init__(n_var=len(KEYS), n_obj=1, xl=lo, xu=hi)
+
+        def _evaluate(self, X, out, *args, **kw):
+            out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds) for x in X])))
+
+    res = minimize(Tune(), GA(pop_size=a.pop), ("n_gen", a.gens), seed=a.seed, verbose=True)
+    print("best cost", float(res.F[0]))
+    print("ControlParams(" + ", ".join(f"{k}={v:.3g}" for k, v in zip(KEYS, res.X)) + ")")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,80 @@
+"""The dm_control environments: dm_env conformance, named accessors, the model's actuator map."""
+import unittest
+
+import mujoco
+import numpy as np
+import pytest
+from dm_env import test_utils
+
+import envs
+from cpg.errors import InputError
+from envs.biped import load_physics
+from models import BIPED_SCENE
+
+
+class TestWalkConformance(test_utils.EnvironmentTestMixin, unittest.TestCase):
+    def make_object_under_test(self):
+        return envs.load("walk", time_limit=0.5, random=0)
+
+
+class TestHopConformance(test_utils.EnvironmentTestMixin, unittest.TestCase):
+    def make_object_under_test(self):
+        return envs.load("hop", time_limit=0.5, random=1, random_cpg_state=True)
+
+
+def test_model_compiles_without_warnings_and_actuator_map():
+    m = mujoco.MjModel.from_xml_path(str(BIPED_SCENE))
+    d = mujoco.MjData(m)
+    for _ in range(200):
+        mujoco.mj_step(m, d)
+    assert all(w.number == 0 for w in d.warning)
+    names = [m.actuator(i).name for i in range(m.nu)]
+    assert names[:4] == ["LF", "RF", "LE", "RE"]
+    for i, joint in enumerate(["left_ankle", "right_ankle", "left_ankle", "right_ankle"]):
+        assert m.joint(m.actuator_trnid[i, 0]).name == joint
+        assert tuple(m.actuator_ctrlrange[i]) == (0.0, 1.0)
+    # Flexors pull only toward dorsiflexion (+), extensors only toward plantarflexion (-).
+    assert m.actuator_forcerange[0, 0] == 0 and m.actuator_forcerange[0, 1] > 0
+    assert m.actuator_forcerange[2, 1] == 0 and m.actuator_forcerange[2, 0] < 0
+    assert sorted(m.sensor(i).name for i in range(m.nsensor) if m.sensor_type[i] ==
+                  mujoco.mjtSensor.mjSENS_CONTACT) == ["left_foot_contact", "right_foot_contact"]
+
+
+def test_co_activation_stiffens_the_ankle():
+    """Flexor + extensor fully on: restoring torque ~ 2 K q around the balance angle."""
+    m = mujoco.MjModel.from_xml_path(str(BIPED_SCENE))
+    d = mujoco.MjData(m)
+    d.act[:4] = 1.0
+    torques = []
+    for q in (-0.1, 0.1):
+        d.qpos[m.jnt_qposadr[m.joint("left_ankle").id]] = q
+        mujoco.mj_forward(m, d)
+        torques.append(d.actuator_force[0] + d.actuator_force[2])
+    k_eff = -(torques[1] - torques[0]) / 0.2
+    assert k_eff == pytest.approx(2 * 150.0, rel=0.01)
+
+
+def test_accessors_at_rest():
+    ph = load_physics()
+    ph.forward()
+    assert ph.torso_height() == pytest.approx(0.862, abs=1e-6)
+    assert ph.torso_pitch() == 0.0 and np.allclose(ph.joint_angles(), 0)
+    for _ in range(300):
+        ph.step()
+    f = ph.foot_forces()
+    assert f.sum() == pytest.approx(21.0 * 9.81, rel=0.05)  # standing: the weight on the feet
+    assert ph.foot_contacts().all()
+    ph.free()
+
+
+def test_bad_model_and_task(tmp_path):
+    bad = tmp_path / "broken.xml"
+    bad.write_text("<mujoco><worldbody><body></mujoco>")
+    with pytest.raises(InputError, match="cannot load MJCF"):
+        load_physics(bad)
+    with pytest.raises(InputError, match="does not exist"):
+        load_physics(tmp_path / "missing.xml")
+    with pytest.raises(InputError, match="unknown task"):
+        envs.load("moonwalk")
+    with pytest.raises(InputError, match="weights file"):
+        envs.load("free")
