@@ -218,16 +218,123 @@ def cmd_secondary(a) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------- physical biped
+def _weights_arg(a):
+    """(gait, weights or None, source label) from --gait and --weights FILE."""
+    if a.weights is None:
+        return a.gait, None, "paper Table 2"
+    from cpg.search import load_result
+
+    data = load_result(a.weights)
+    if a.gait != data["gait"]:
+        print(f"cpgbiped: note: {a.weights} was optimised for {data['gait']}; using it for "
+              f"{a.gait}", file=sys.stderr)
+    return a.gait, data["chosen"]["weights"], a.weights
+
+
+def _push(a):
+    if a.push is None:
+        return None
+    t, imp = a.push
+    if not (t >= 0 and abs(imp) < 1e4):
+        raise _input_error(f"--push needs a time >= 0 s and an impulse below 1e4 N s, got {a.push}")
+    return (t, imp)
+
+
+def _input_error(msg):
+    from cpg.errors import InputError
+
+    return InputError(msg)
+
+
+def _metrics_rows(summaries: dict) -> str:
+    rows = []
+    for name, s in summaries.items():
+        d = s["duty_factor"]
+        rows.append([name, "yes" if s["fell"] else "no", f"{d['left']:.2f}/{d['right']:.2f}",
+                     f"{s['lr_phase_lag']:.2f}", f"{s['double_support']:.2f}", f"{s['flight']:.2f}",
+                     f"{s['stride_period_s']:.2f}", f"{s['distance_m']:.2f}",
+                     s["physical_gait"], s["cpg_gait"], "PASS" if s["passed"] else "fail"])
+    return _fmt_table(rows, ["rollout", "fell", "duty L/R", "L-R lag", "double", "flight",
+                             "stride s", "dist m", "physical", "cpg", "verdict"])
+
+
+def cmd_validate(a) -> int:
+    from cpg import io
+    from envs.validate import validate
+
+    gait, w, src = _weights_arg(a)
+    v = validate(gait, w, a.seconds, a.seed, a.friction_scale, _push(a))
+    s = v.summary()
+    s["weights_source"] = src
+    if a.rrd:
+        from envs.record import write_rrd
+
+        write_rrd(a.rrd, {gait: (v.recording, v.metrics)})
+    if a.json:
+        print(io.to_json(s))
+    else:
+        print(f"{gait} ({src}), {a.seconds:g} s after {2.0:g} s settling"
+              + (f", friction x{a.friction_scale:g}" if a.friction_scale != 1 else ""))
+        print(_metrics_rows({gait: s}))
+        if s["unstable"]:
+            print(f"physics: {s['unstable']}")
+    return 0
+
+
+def cmd_render(a) -> int:
+    from envs.render import check_backend, check_video_size, gait_diagram, render_video, signals_picture
+    from envs.validate import validate
+
+    check_video_size(a.width, a.height, a.fps, a.seconds)
+    if not a.out.endswith(".mp4"):
+        raise _input_error(f"--out must name an .mp4 file, got {a.out!r}")
+    check_backend()
+    gait, w, src = _weights_arg(a)
+    v = validate(gait, w, a.seconds, a.seed, a.friction_scale, None, settle_s=0.0,
+                 record_qpos=True)
+    path = render_video(v.recording, a.out, a.fps, a.width, a.height, a.seconds,
+                        signals=not a.no_signals, fancy=a.fancy)
+    stem = os.path.splitext(a.out)[0]
+    gait_diagram(v.recording, stem + "_gait.png", v.metrics, f"{gait} ({src})")
+    signals_picture(v.recording, stem + "_signals.png", f"{gait} ({src})")
+    if a.rrd:
+        from envs.record import write_rrd
+
+        write_rrd(a.rrd, {gait: (v.recording, v.metrics)}, {gait: path})
+    print(f"wrote {path}, {stem}_gait.png, {stem}_signals.png" + (f", {a.rrd}" if a.rrd else ""))
+    return 0
+
+
+def cmd_log(a) -> int:
+    from envs.record import write_rrd
+    from envs.validate import validate
+
+    if not a.rrd.endswith(".rrd"):
+        raise _input_error(f"--rrd must name an .rrd file, got {a.rrd!r}")
+    gait, w, src = _weights_arg(a)
+    v = validate(gait, w, a.seconds, a.seed, a.friction_scale, _push(a))
+    write_rrd(a.rrd, {gait: (v.recording, v.metrics)})
+    print(f"wrote {a.rrd} ({gait}, {src}; physical: {v.metrics.physical_gait}); open it with: "
+          f"rerun {a.rrd}")
+    return 0
+
+
+def cmd_check_pareto(a) -> int:
+    from envs.pareto import check_pareto
+
+    res = check_pareto(a.result, a.out, first=a.first, seconds=a.seconds, render=a.render,
+                       rrd=a.rrd, workers=a.workers, progress=not a.quiet)
+    print(res["markdown"])
+    print(f"wrote {a.out}/pareto_check.md, .csv, .json")
+    return 0
+
+
 # --------------------------------------------------------------------------------------- demo
 def cmd_demo(a) -> int:
-    from cpg import io
+    from envs.demo import run_demo
 
-    out = io.ensure_dir(a.out)
-    print("== 1/2  the paper's four gaits in the 4-cell Morris-Lecar network")
-    ns = argparse.Namespace(dt=0.02, plot=True, json=False, out=str(out))
-    cmd_reproduce(ns)
-    print("\n== 2/2  the 12-neuron Matsuoka network: printed vs calibrated")
-    cmd_matsuoka(argparse.Namespace(json=False, seed=0))
+    run_demo(a.out, seconds=a.seconds, video_seconds=a.video_seconds, progress=not a.quiet)
     return 0
 
 
@@ -243,9 +350,79 @@ def build_parser() -> argparse.ArgumentParser:
         sp.set_defaults(func=func)
         return sp
 
-    sp = add("demo", cmd_demo, "run the main job and summarise it in out/demo",
-             "Run the product end to end with its defaults and write the results under --out.")
+    sp = add("demo", cmd_demo, "run the main job and summarise it in out/demo", """\
+        The main job, end to end: the paper's four gaits reproduced in the 4-cell network;
+        then each gait (the optimiser's weights when out/optimize/<gait>.json exists, else
+        the paper's) drives the physical biped, is validated from its ground contacts,
+        rendered off-screen to video, and logged to one rerun recording. Writes under --out:
+        <gait>.mp4, <gait>_gait.png, <gait>_signals.png, <gait>_frame.png, demo.rrd,
+        summary.json and README.md with the table and the pictures.""")
     sp.add_argument("--out", default="out/demo", help="output folder (default: out/demo)")
+    sp.add_argument("--seconds", type=float, default=20.0, help="validated seconds per gait")
+    sp.add_argument("--video-seconds", type=float, default=8.0, help="seconds of video per gait")
+    sp.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    def rollout_args(sp, rrd_required=False):
+        sp.add_argument("--gait", default="walk", help="walk, run, jump or hop (default walk)")
+        sp.add_argument("--weights", metavar="FILE",
+                        help="optimiser result JSON whose chosen (w_a, w_b, w_c) to use")
+        sp.add_argument("--seconds", type=float, default=20.0,
+                        help="simulated seconds after 2 s of settling (default 20)")
+        sp.add_argument("--seed", type=int, default=None,
+                        help="random initial CPG state from this seed (default: Table 3 state)")
+        sp.add_argument("--friction-scale", type=float, default=1.0, metavar="F",
+                        help="multiply every floor/foot friction coefficient by F")
+        sp.add_argument("--rrd", required=rrd_required, metavar="FILE.rrd",
+                        help="also write a rerun recording")
+
+    sp = add("validate", cmd_validate, "drive the biped with a gait and measure it", """\
+        Run the CPG-driven biped and measure the gait from its foot contacts (debounced):
+        duty factor per foot, left-right phase lag (fraction of a stride), double support,
+        flight, stride period, distance, speed; a physical verdict (walk/run/jump/hop/none)
+        from those numbers alone, next to the gait the CPG classifier names from the cell
+        outputs. PASS when both agree with --gait and the body did not fall.""")
+    rollout_args(sp)
+    sp.add_argument("--push", type=float, nargs=2, metavar=("T_S", "IMPULSE_NS"),
+                    help="horizontal impulse on the torso at time T_S (N s)")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+
+    sp = add("render", cmd_render, "render a rollout off-screen to mp4", """\
+        Render a rollout with MuJoCo's off-screen renderer (MUJOCO_GL: osmesa by default,
+        egl accepted) to an mp4 (mediapy/ffmpeg), frames taken by simulated time; a side
+        camera tracks the torso, foot markers turn green in stance; a strip of the four CPG
+        signals runs below unless --no-signals. Also writes FILE_gait.png (footfall
+        diagram) and FILE_signals.png beside the video.""")
+    rollout_args(sp)
+    sp.add_argument("--width", type=int, default=640)
+    sp.add_argument("--height", type=int, default=480)
+    sp.add_argument("--fps", type=float, default=30.0)
+    sp.add_argument("--fancy", action="store_true", help="shadows and reflections (slower)")
+    sp.add_argument("--no-signals", action="store_true", help="no CPG strip under the video")
+    sp.add_argument("--out", required=True, metavar="FILE.mp4")
+    sp.set_defaults(seconds=8.0)
+
+    sp = add("log", cmd_log, "write a rerun recording of a rollout", """\
+        Write a rerun .rrd of a rollout on the sim_time timeline: CPG outputs, ankle
+        activations, joint angles, torso height and pitch, foot contacts and forces,
+        touchdown/lift-off events and the gait metrics; the default view shows the gait
+        diagram above the CPG signals. Open it with 'rerun FILE.rrd'.""")
+    rollout_args(sp, rrd_required=True)
+    sp.add_argument("--push", type=float, nargs=2, metavar=("T_S", "IMPULSE_NS"))
+
+    sp = add("check-pareto", cmd_check_pareto, "run an optimiser result's Pareto points in physics",
+             """\
+        Take an optimiser result (cpgbiped optimize ... --out DIR: DIR/<gait>.json), run
+        every Pareto point (or the first N) through the physical validation in parallel
+        processes, optionally render each, and write DIR/pareto_check.md, .csv and .json:
+        weights, phase errors, physical metrics and PASS/fail per point.""")
+    sp.add_argument("result", help="optimiser result JSON")
+    sp.add_argument("--first", type=int, default=None, metavar="N", help="only the first N points")
+    sp.add_argument("--seconds", type=float, default=20.0)
+    sp.add_argument("--render", action="store_true", help="render each point to video")
+    sp.add_argument("--rrd", metavar="FILE.rrd", help="log every point to one recording")
+    sp.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    sp.add_argument("--out", required=True, metavar="DIR")
+    sp.add_argument("--quiet", action="store_true")
 
     sp = add("reproduce", cmd_reproduce, "the paper's four gaits from its Table 2 weights", """\
         Simulate the 4-cell network for walk, run, jump and hop with the paper's Table 2

@@ -1,0 +1,119 @@
+"""rerun recordings of rollouts: columns on a ``sim_time`` timeline, and reading them back.
+
+Entities, per rollout under ``/<name>`` (e.g. ``/walk``):
+  contacts/left, contacts/right       debounced foot contact (0/1), the gait diagram
+  force/left, force/right             normal ground reaction force (N)
+  cpg/LF .. cpg/RE                    the four CPG cell outputs
+  activation/LF .. activation/RE      ankle muscle activations
+  joints/<leg>_<joint>                hip, knee, ankle angles (rad)
+  torso/height, torso/pitch           m, rad
+  events/<leg>/touchdown|liftoff      1.0 at each event time
+  metrics                             the gait metrics as a Markdown document (static)
+  video                               the rendered video as an asset (optional)
+Everything is logged with ``send_columns`` (one call per series, not per step). The default
+blueprint shows, per rollout, the contacts above the CPG signals. Written to a temporary file
+and renamed.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from cpg.errors import InputError
+from cpg.io import atomic_path, to_json
+
+from .gait_metrics import debounce, edges
+
+CELLS = ("LF", "RF", "LE", "RE")
+JOINTS = tuple(f"{leg}_{j}" for leg in ("left", "right") for j in ("hip", "knee", "ankle"))
+
+
+def _columns(rec_stream, path: str, t: np.ndarray, x: np.ndarray):
+    import rerun as rr
+
+    rec_stream.send_columns(path, indexes=[rr.TimeColumn("sim_time", duration=t)],
+                            columns=rr.Scalars.columns(scalars=np.asarray(x, dtype=float)))
+
+
+def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = None) -> None:
+    """Log one recording under ``/<name>`` to an open ``rr.RecordingStream``."""
+    import rerun as rr
+
+    t = rec.t
+    for i, leg in enumerate(("left", "right")):
+        c = debounce(rec.contact[:, i], rec.dt)
+        _columns(rs, f"/{name}/contacts/{leg}", t, c.astype(float))
+        _columns(rs, f"/{name}/force/{leg}", t, rec.force[:, i])
+        td, lo = edges(t, c)
+        if len(td):
+            _columns(rs, f"/{name}/events/{leg}/touchdown", td, np.ones(len(td)))
+        if len(lo):
+            _columns(rs, f"/{name}/events/{leg}/liftoff", lo, np.ones(len(lo)))
+    for k, cell in enumerate(CELLS):
+        _columns(rs, f"/{name}/cpg/{cell}", t, rec.cpg_v[:, k])
+        _columns(rs, f"/{name}/activation/{cell}", t, rec.activation[:, k])
+    for j, joint in enumerate(JOINTS):
+        _columns(rs, f"/{name}/joints/{joint}", t, rec.joints[:, j])
+    _columns(rs, f"/{name}/torso/height", t, rec.torso_height)
+    _columns(rs, f"/{name}/torso/pitch", t, rec.torso_pitch)
+    if metrics is not None:
+        md = "```json\n" + to_json(metrics.as_dict() if hasattr(metrics, "as_dict") else metrics) + "\n```"
+        rs.log(f"/{name}/metrics", rr.TextDocument(md, media_type="text/markdown"), static=True)
+    if video is not None:
+        asset = rr.AssetVideo(path=str(video))
+        rs.log(f"/{name}/video", asset, static=True)
+        ts = asset.read_frame_timestamps_nanos()
+        rs.send_columns(f"/{name}/video", indexes=[rr.TimeColumn("sim_time", duration=ts * 1e-9)],
+                        columns=rr.VideoFrameReference.columns_nanos(ts))
+
+
+def blueprint(names):
+    import rerun.blueprint as rrb
+
+    tabs = [rrb.Vertical(rrb.TimeSeriesView(origin=f"/{n}/contacts", name=f"{n}: gait diagram"),
+                         rrb.TimeSeriesView(origin=f"/{n}/cpg", name=f"{n}: CPG"),
+                         rrb.TimeSeriesView(origin=f"/{n}/joints", name=f"{n}: joints"),
+                         name=n) for n in names]
+    return rrb.Blueprint(rrb.Tabs(*tabs) if len(tabs) > 1 else tabs[0])
+
+
+def write_rrd(path: str | Path, rollouts: dict, videos: dict | None = None) -> Path:
+    """One .rrd holding every rollout: ``rollouts`` maps name -> (Recording, metrics)."""
+    import rerun as rr
+
+    path = Path(path)
+    if path.suffix != ".rrd":
+        raise InputError(f"rerun recordings end in .rrd, got {str(path)!r}")
+    with atomic_path(path, suffix=".rrd") as tmp:
+        rs = rr.RecordingStream("cpgbiped")
+        rs.save(str(tmp))
+        for name, (rec, metrics) in rollouts.items():
+            log_rollout(rs, name, rec, metrics, (videos or {}).get(name))
+        rs.send_blueprint(blueprint(list(rollouts)))
+        rs.flush()
+        rs.disconnect()
+    return path
+
+
+def read_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Scalar series of an .rrd: entity path -> (sim_time in s, values), via rerun's reader."""
+    from rerun.chunk import RrdReader
+
+    out: dict[str, list] = {}
+    for chunk in RrdReader(str(path)).store().stream():
+        batch = chunk.to_record_batch()
+        names = batch.schema.names
+        if "sim_time" not in names or "Scalars:scalars" not in names:
+            continue
+        col = batch.column("sim_time")
+        t = np.asarray(col.cast("int64").to_numpy(zero_copy_only=False), dtype=float) * 1e-9
+        v = np.array([s[0] for s in batch.column("Scalars:scalars").to_pylist()], dtype=float)
+        out.setdefault(str(chunk.entity_path), []).append((t, v))
+    res = {}
+    for k, parts in out.items():
+        t = np.concatenate([p[0] for p in parts])
+        v = np.concatenate([p[1] for p in parts])
+        o = np.argsort(t, kind="stable")
+        res[k] = (t[o], v[o])
+    return res

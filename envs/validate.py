@@ -1,0 +1,68 @@
+"""Physical validation of a gait: one rollout, contact metrics, and both verdicts.
+
+``cpg_gait`` is what :func:`cpg.gaits.classify` names from the four CPG outputs recorded
+during the rollout; ``physical_gait`` is what :mod:`envs.gait_metrics` names from the foot
+contacts alone. A gait is physically real when the two agree and the body did not fall.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cpg import morris_lecar as ml
+from cpg.errors import InputError
+from cpg.gaits import classify
+
+from .biped import Recording, rollout
+from .controller import GAIT_CONTROL
+from .gait_metrics import GaitMetrics, measure
+
+SETTLE_S = 2.0
+
+
+@dataclass
+class Validation:
+    gait: str
+    recording: Recording
+    metrics: GaitMetrics
+    cpg_gait: str
+
+    def summary(self) -> dict:
+        m = self.metrics
+        return {
+            "gait": self.gait, "fell": m.fell, "fell_at_s": m.fell_at_s,
+            "unstable": self.recording.unstable,
+            "duty_factor": m.duty_factor, "lr_phase_lag": m.lr_phase_lag,
+            "double_support": m.double_support, "flight": m.flight,
+            "stride_period_s": m.stride_period_s, "distance_m": m.distance_m,
+            "speed_mps": m.speed_mps, "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
+            "passed": bool(not m.fell and m.physical_gait == self.gait == self.cpg_gait),
+        }
+
+
+def network_for(gait: str, weights=None):
+    """(I_app, phi, W, y0): Table 2 for the gait, with optional (w_a, w_b, w_c) instead."""
+    if gait not in GAIT_CONTROL:
+        raise InputError(f"unknown gait {gait!r}: physical gaits are {', '.join(GAIT_CONTROL)}")
+    p = ml.preset(gait)
+    w = np.array(p.weights if weights is None else weights, dtype=float)
+    if w.shape != (3,):
+        raise InputError(f"weights must be three numbers (w_a, w_b, w_c), got shape {w.shape}")
+    return p.i_app, p.phi, ml.weight_matrix(w), p.y0
+
+
+def validate(gait: str, weights=None, seconds: float = 20.0, seed: int | None = None,
+             friction_scale: float = 1.0, push: tuple[float, float] | None = None,
+             settle_s: float = SETTLE_S, record_qpos: bool = False) -> Validation:
+    """Roll out ``seconds`` after ``settle_s`` of settling and measure the gait."""
+    if not (np.isfinite(seconds) and seconds > 0):
+        raise InputError(f"seconds must be a positive number, got {seconds}")
+    rec = rollout(network_for(gait, weights), GAIT_CONTROL[gait], seconds + settle_s, seed=seed,
+                  friction_scale=friction_scale, push=push, record_qpos=record_qpos,
+                  stop_on_fall=not record_qpos)
+    fell_at = rec.fell_at if rec.unstable is None else (rec.t[-1] if len(rec.t) else 0.0)
+    m = measure(rec.t, rec.contact, rec.com_x, fell_at, settle_s=settle_s)
+    steady = rec.t >= settle_s
+    cpg_name = classify(rec.t[steady], rec.cpg_v[steady])[0] if steady.sum() > 16 else "none"
+    return Validation(gait, rec, m, cpg_name)
