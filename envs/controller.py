@@ -7,8 +7,9 @@ Data flow per control tick (every ``control_every`` physics steps, ctrl held in 
 2. Activation map. Cell output v -> muscle activation a = 1 / (1 + exp(-(v - v_half) / width))
    in [0, 1]; a_LF, a_RF, a_LE, a_RE drive the ankle flexor/extensor actuators directly.
 3. Pattern formation (timing from the CPG only). Alternating gaits (walk, run: the legs'
-   extensor cells in antiphase): the leg whose extensor activation is the weaker one has the
-   swing command. Two-legged gaits (jump, hop: extensors in phase): both legs have it while
+   extensor cells in antiphase): the leg whose extensor activation is below the other's by
+   more than ``swing_margin`` has the swing command (the margin leaves both legs in stance
+   around the switch: double support). Two-legged gaits (jump, hop: extensors in phase): both legs have it while
    the extensors are off (a_E < 0.5).
 4. Balance (SIMBICON-style, stance read from the foot contact sensors):
    - contact priority: a foot on the ground stays a stance foot while the other leg is in the
@@ -57,19 +58,20 @@ class ControlParams:
     kd_knee: float = 0.1
     push: float = 0.3  # stance knee extension torque per unit extensor activation
     ankle_gain: float = 1.0  # ankle muscle ctrl = ankle_gain * activation
+    swing_margin: float = 0.0  # alternating gaits: swing only when a_E < a_E(other) - margin
     two_legged: bool = False  # jump/hop: both legs share stance and flight
 
 
 # Presets: the paper's (I_app, phi, w_a, w_b, w_c) from Table 2 with controller settings.
 GAIT_CONTROL = {
-    # Provisional: the best of a 200-sample random search of these gains per gait (survival
-    # over 10 s, then distance). See README "Status of the physical gaits".
-    "walk": ControlParams(ankle_gain=0.25, push=0.12, theta0=0.14, c_v=0.26, c_d=0.37,
-                          kp_t=5.94, kd_t=0.7, knee_swing=-0.56, time_scale=8.41, pitch_d=0.09,
-                          kp_sw=2.63, kp_knee=0.68),
-    "run": ControlParams(ankle_gain=0.4, push=0.16, theta0=0.12, c_v=0.01, c_d=0.65, kp_t=5.56,
-                         kd_t=0.52, knee_swing=-0.67, time_scale=12.35, pitch_d=0.18, kp_sw=3.36,
-                         kp_knee=0.51),
+    # Tuned with scripts/tune_controller.py (pymoo GA, fitness from the acceptance criteria);
+    # provisional where the criteria are not met yet: see README "Status of the physical gaits".
+    "walk": ControlParams(ankle_gain=0.0725, push=0.67, theta0=0.491, c_v=0.0888, c_d=0.71,
+                          kp_t=1.38, kd_t=0.797, knee_swing=-0.987, time_scale=10.2,
+                          pitch_d=0.148, kp_sw=2.35, kp_knee=3.41),
+    "run": ControlParams(ankle_gain=0.603, push=0.321, theta0=0.306, c_v=0.144, c_d=0.55,
+                         kp_t=5.99, kd_t=0.494, knee_swing=-1.27, time_scale=11.0, pitch_d=0.145,
+                         kp_sw=2.45, kp_knee=1.03),
     "jump": ControlParams(two_legged=True, ankle_gain=0.35, push=0.5, theta0=0.48, c_v=0.13,
                           c_d=0.48, kp_t=1.97, kd_t=0.21, knee_swing=-0.9, time_scale=12.34,
                           pitch_d=0.2, kp_sw=3.94, kp_knee=2.32),
@@ -138,8 +140,8 @@ class CPGController:
         self.last_v, self.last_act = v, a
         if p.two_legged:
             swing_cmd = a[2:] < 0.5  # both legs together: extensors off
-        else:  # alternating: the leg whose extensor is the weaker one swings
-            swing_cmd = np.array([a[2] < a[3], a[3] <= a[2]])
+        else:  # alternating: the leg whose extensor is clearly the weaker one swings
+            swing_cmd = np.array([a[2] < a[3] - p.swing_margin, a[3] < a[2] - p.swing_margin])
         contact = ph.foot_contacts()
         st = self.state
         if p.two_legged:

@@ -6,7 +6,8 @@ contact or no-contact shorter than ``min_phase_s`` is merged into its neighbours
 
 Definitions (over the analysis window, after the settling period):
 - touchdown / lift-off: rising / falling edges of the debounced contact of a foot;
-- stride period: mean interval between successive touchdowns of a foot (both feet pooled);
+- stride period: median interval between successive touchdowns of a foot (both feet pooled;
+  the median ignores the odd stumble);
 - duty factor of a foot: fraction of the time in contact;
 - left-right lag: for each left touchdown, (next right touchdown - it) / stride period,
   circular mean as a fraction of a stride in [0, 1); 0.5 = alternating, 0 = together;
@@ -132,7 +133,7 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
     for i, leg in enumerate(("left", "right")):
         td[leg], lo[leg] = edges(ts, cs[:, i]) if len(ts) > 1 else (np.empty(0), np.empty(0))
     strides = np.concatenate([np.diff(td["left"]), np.diff(td["right"])])
-    period = float(np.mean(strides)) if len(strides) else float("nan")
+    period = float(np.median(strides)) if len(strides) else float("nan")
     window = float(ts[-1] - ts[0]) if len(ts) > 1 else 0.0
     distance = float(com_x[sel][-1] - com_x[sel][0]) if sel.sum() > 1 else 0.0
     m = GaitMetrics(

@@ -284,12 +284,13 @@ def cmd_validate(a) -> int:
 
 def cmd_render(a) -> int:
     from envs.render import check_backend, check_video_size, gait_diagram, render_video, signals_picture
-    from envs.validate import validate
 
     check_video_size(a.width, a.height, a.fps, a.seconds)
     if not a.out.endswith(".mp4"):
         raise _input_error(f"--out must name an .mp4 file, got {a.out!r}")
     check_backend()
+    from envs.validate import validate
+
     gait, w, src = _weights_arg(a)
     v = validate(gait, w, a.seconds, a.seed, a.friction_scale, None, settle_s=0.0,
                  record_qpos=True)
@@ -501,11 +502,18 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+GL_BACKENDS = ("osmesa", "egl", "glfw")
+
+
 def main(argv: list[str] | None = None) -> int:
     from cpg.errors import InputError
 
     try:
         args = build_parser().parse_args(argv)
+        gl = os.environ.get("MUJOCO_GL")
+        if gl not in GL_BACKENDS:  # mujoco would refuse to import with a traceback
+            return _fail(f"unsupported MUJOCO_GL={gl!r}: use osmesa (default, apt package "
+                         f"libosmesa6) or egl (libegl1)")
         return int(args.func(args) or 0)
     except SystemExit as e:
         return e.code if isinstance(e.code, int) else 0

@@ -17,7 +17,8 @@ import numpy as np
 
 SPACE = dict(ankle_gain=(0.03, 0.7), push=(0.0, 0.7), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
              c_d=(0.0, 0.8), kp_t=(1.0, 6.0), kd_t=(0.1, 0.8), knee_swing=(-1.4, -0.3),
-             time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0))
+             time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0),
+             swing_margin=(0.0, 0.9))
 KEYS = list(SPACE)
 
 
@@ -65,6 +66,8 @@ def main(argv=None):
     ap.add_argument("--gens", type=int, default=15)
     ap.add_argument("--seconds", type=float, default=12.0)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--start", action="store_true",
+                    help="seed the first population with the gait's current preset")
     a = ap.parse_args(argv)
     lo = np.array([SPACE[k][0] for k in KEYS])
     hi = np.array([SPACE[k][1] for k in KEYS])
@@ -77,7 +80,16 @@ def main(argv=None):
         def _evaluate(self, X, out, *args, **kw):
             out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds) for x in X])))
 
-    res = minimize(Tune(), GA(pop_size=a.pop), ("n_gen", a.gens), seed=a.seed, verbose=True)
+    sampling = None
+    if a.start:  # the current preset plus random points around it
+        from envs.controller import GAIT_CONTROL
+
+        x0 = np.array([getattr(GAIT_CONTROL[a.gait], k) for k in KEYS])
+        rng = np.random.default_rng(a.seed)
+        sampling = np.clip(x0 + 0.1 * (hi - lo) * rng.standard_normal((a.pop, len(KEYS))), lo, hi)
+        sampling[0] = np.clip(x0, lo, hi)
+    algo = GA(pop_size=a.pop) if sampling is None else GA(pop_size=a.pop, sampling=sampling)
+    res = minimize(Tune(), algo, ("n_gen", a.gens), seed=a.seed, verbose=True)
     print("best cost", float(res.F[0]))
     print("ControlParams(" + ", ".join(f"{k}={v:.3g}" for k, v in zip(KEYS, res.X)) + ")")
 

@@ -1,0 +1,152 @@
+"""Videos, rerun recordings, Pareto checks and the demo, as a user gets them from the CLI."""
+import json
+import os
+import subprocess
+import sys
+
+import mediapy
+import numpy as np
+import pytest
+
+from envs.gait_metrics import debounce, edges
+from envs.record import read_rrd
+from envs.validate import validate
+from scripts.cli import main
+
+
+def cli(*args, env=None):
+    e = dict(os.environ)
+    e.update(env or {})
+    return subprocess.run([sys.executable, "-m", "scripts.cli", *args], capture_output=True,
+                          text=True, timeout=900, env=e)
+
+
+def one_line_error(r, msg):
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cpgbiped: error:") and msg in lines[0], r.stderr
+
+
+def test_validate_json_keys(capsys):
+    assert main(["validate", "--gait", "walk", "--seconds", "6", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    for k in ("fell", "duty_factor", "lr_phase_lag", "double_support", "flight",
+              "stride_period_s", "distance_m", "speed_mps", "physical_gait", "cpg_gait"):
+        assert k in s
+    assert set(s["duty_factor"]) == {"left", "right"}
+
+
+def test_render_video(tmp_path):
+    out = tmp_path / "walk.mp4"
+    r = cli("render", "--gait", "walk", "--seconds", "2", "--fps", "10", "--width", "160",
+            "--height", "120", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    video = mediapy.read_video(str(out))
+    assert video.shape[0] == 20 and video.shape[1:3] == (120, 160)
+    assert video.std() > 5  # not blank
+    assert np.abs(video[-1].astype(int) - video[0].astype(int)).mean() > 1  # changes over time
+    assert (tmp_path / "walk_gait.png").exists() and (tmp_path / "walk_signals.png").exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+@pytest.mark.parametrize("args,msg", [
+    (["--width", "161", "--height", "120"], "odd"),
+    (["--seconds", "0"], "seconds must be positive"),
+    (["--gait", "skip"], "unknown gait"),
+])
+def test_render_bad_input_no_file(tmp_path, args, msg):
+    out = tmp_path / "v.mp4"
+    r = cli("render", *args, "--out", str(out))
+    one_line_error(r, msg)
+    assert not out.exists()
+
+
+def test_render_unavailable_backend(tmp_path):
+    r = cli("render", "--seconds", "1", "--out", str(tmp_path / "v.mp4"),
+            env={"MUJOCO_GL": "nosuchgl", "PYOPENGL_PLATFORM": "nosuchgl"})
+    one_line_error(r, "MUJOCO_GL")
+    assert not (tmp_path / "v.mp4").exists()
+
+
+def test_rrd_contacts_match_validate(tmp_path):
+    rrd = tmp_path / "walk.rrd"
+    r = cli("log", "--gait", "walk", "--seconds", "8", "--rrd", str(rrd))
+    assert r.returncode == 0, r.stderr
+    series = read_rrd(rrd)
+    for leg in ("left", "right"):
+        assert f"/walk/contacts/{leg}" in series
+    for cell in ("LF", "RF", "LE", "RE"):
+        t, v = series[f"/walk/cpg/{cell}"]
+        assert len(t) > 100 and np.ptp(v) > 0.1
+    v = validate("walk", seconds=8.0)  # the same deterministic rollout
+    dt_phys = v.recording.physics_dt
+    for leg in ("left", "right"):
+        t, c = series[f"/walk/contacts/{leg}"]
+        td_logged = edges(t, c > 0.5)[0]
+        td_logged = td_logged[td_logged >= 2.0]
+        td_validate = np.array(v.metrics.touchdowns[leg])
+        assert len(td_logged) == len(td_validate) > 3
+        assert np.max(np.abs(td_logged - td_validate)) <= dt_phys + 1e-9
+
+
+def pareto_file(tmp_path):
+    f = tmp_path / "hop.json"
+    f.write_text(json.dumps({"format": "cpgbiped.optimize/1", "gait": "walk",
+                             "chosen": {"weights": [0.39, -0.681, 0.489], "errors_deg": [0, 0, 0]},
+                             "pareto": [{"weights": [0.39, -0.681, 0.489], "errors_deg": [0, 0, 0]},
+                                        {"weights": [0.3, -0.6, 0.5], "errors_deg": [0.1, 0, 0]}]}))
+    return f
+
+
+def test_check_pareto_table(tmp_path):
+    out = tmp_path / "check"
+    r = cli("check-pareto", str(pareto_file(tmp_path)), "--seconds", "4", "--out", str(out),
+            "--quiet")
+    assert r.returncode == 0, r.stderr
+    data = json.loads((out / "pareto_check.json").read_text())
+    assert [p["point"] for p in data["points"]] == [0, 1]
+    assert (out / "pareto_check.csv").read_text().count("\n") == 3
+    assert (out / "pareto_check.md").read_text().count("\n| ") == 3
+
+
+def test_check_pareto_bad_input(tmp_path):
+    one_line_error(cli("check-pareto", str(tmp_path / "none.json"), "--out", str(tmp_path / "o")),
+                   "does not exist")
+    (tmp_path / "x.json").write_text('{"format": "other"}')
+    one_line_error(cli("check-pareto", str(tmp_path / "x.json"), "--out", str(tmp_path / "o")),
+                   "not a cpgbiped optimiser result")
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o500)
+    if os.access(ro, os.W_OK):  # running as root: a file in the way is unwritable for everyone
+        ro = tmp_path / "file_in_the_way"
+        ro.write_text("x")
+        target = ro / "sub"
+    else:
+        target = ro
+    r = cli("check-pareto", str(pareto_file(tmp_path)), "--out", str(target), "--quiet")
+    one_line_error(r, "output folder")
+
+
+def test_validate_bad_weights_file(tmp_path):
+    f = tmp_path / "w.json"
+    f.write_text('{"format": "cpgbiped.optimize/1", "gait": "walk", "chosen": {"weights": '
+                 '[NaN, 0, 0]}, "pareto": []}')
+    one_line_error(cli("validate", "--weights", str(f)), "finite")
+    f.write_text("{not json")
+    one_line_error(cli("validate", "--weights", str(f)), "not readable JSON")
+    one_line_error(cli("validate", "--gait", "gallop"), "unknown gait")
+
+
+def test_demo_produces_everything(tmp_path):
+    out = tmp_path / "demo"
+    r = cli("demo", "--out", str(out), "--seconds", "4", "--video-seconds", "1", "--quiet")
+    assert r.returncode == 0, r.stderr
+    for g in ("walk", "run", "jump", "hop"):
+        for suffix in (".mp4", "_gait.png", "_signals.png", "_frame.png"):
+            assert (out / f"{g}{suffix}").stat().st_size > 0
+    assert (out / "demo.rrd").stat().st_size > 0
+    readme = (out / "README.md").read_text()
+    assert "walk_frame.png" in readme and "verdict" in readme
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary["physics"]) == {"walk", "run", "jump", "hop"}
