@@ -66,9 +66,9 @@ class ControlParams:
 GAIT_CONTROL = {
     # Tuned with scripts/tune_controller.py (pymoo GA, fitness from the acceptance criteria);
     # provisional where the criteria are not met yet: see README "Status of the physical gaits".
-    "walk": ControlParams(ankle_gain=0.0725, push=0.67, theta0=0.491, c_v=0.0888, c_d=0.71,
-                          kp_t=1.38, kd_t=0.797, knee_swing=-0.987, time_scale=10.2,
-                          pitch_d=0.148, kp_sw=2.35, kp_knee=3.41),
+    "walk": ControlParams(ankle_gain=0.0726, push=0.662, theta0=0.501, c_v=0.0631, c_d=0.681,
+                          kp_t=1.01, kd_t=0.762, knee_swing=-0.912, time_scale=11.7,
+                          pitch_d=0.148, kp_sw=2.08, kp_knee=3.4, swing_margin=0.25),
     "run": ControlParams(ankle_gain=0.603, push=0.321, theta0=0.306, c_v=0.144, c_d=0.55,
                          kp_t=5.99, kd_t=0.494, knee_swing=-1.27, time_scale=11.0, pitch_d=0.145,
                          kp_sw=2.45, kp_knee=1.03),

@@ -1,10 +1,11 @@
-"""The CPG-driven biped in physics: what the current controller achieves, tested honestly.
+"""The CPG-driven biped in physics, against the acceptance criteria of the physical gaits.
 
-Walk: no fall over 20 s, legs alternate (lag 0.5 +- 0.1), essentially no flight, >= 2 m,
-and the CPG classifier names walk, from the Table 3 state, random CPG states and with the
-floor friction scaled by 0.7 and 1.3. The footfalls follow the CPG's phase. Criteria the
-controller does not meet yet (duty >= 0.55 / double support > 5% for walk; run, jump and hop
-altogether) are listed in the README's status section, not asserted here.
+Walk (issue criteria, 20 s after 2 s of settling): no fall; left-right lag 0.5 +- 0.1; duty
+factor >= 0.55 on both feet; double support > 5%; flight < 2%; >= 2 m; the contact-only
+classifier and the CPG classifier both name walk; from the Table 3 state, 10 random CPG
+states, and with floor friction x0.7 and x1.3. Run, jump and hop do not meet theirs yet
+(README, "Status of the physical gaits"): they are not asserted here beyond getting a
+verdict.
 """
 import shutil
 
@@ -21,18 +22,20 @@ from models import BIPED_DIR
 
 def check_walk(s):
     assert not s["fell"], s
-    assert abs(s["lr_phase_lag"] - 0.5) <= 0.1
-    assert s["flight"] < 0.02
-    assert s["distance_m"] >= 2.0
-    assert s["cpg_gait"] == "walk"
+    assert abs(s["lr_phase_lag"] - 0.5) <= 0.1, s
+    assert min(s["duty_factor"].values()) >= 0.55, s
+    assert s["double_support"] > 0.05, s
+    assert s["flight"] < 0.02, s
+    assert s["distance_m"] >= 2.0, s
+    assert s["physical_gait"] == "walk" and s["cpg_gait"] == "walk", s
 
 
-@pytest.mark.parametrize("seed", [None, 3, 4])
+@pytest.mark.parametrize("seed", [None] + list(range(10, 20)))
 def test_walk_from_cpg_states(seed):
     check_walk(validate("walk", seconds=20.0, seed=seed).summary())
 
 
-@pytest.mark.parametrize("friction", [1.3])  # x0.7 falls after ~8 m: see README status
+@pytest.mark.parametrize("friction", [0.7, 1.3])
 def test_walk_with_scaled_friction(friction):
     check_walk(validate("walk", seconds=20.0, friction_scale=friction).summary())
 

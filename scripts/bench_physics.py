@@ -1,0 +1,116 @@
+"""Benchmark: the physical biped, in one run (ratios against baselines measured here).
+
+1. Physics steps per second with the CPG and controller in the loop (``rollout``: the CPG is
+   integrated ahead in one batch, the controller runs every 2 physics steps) vs plain
+   ``mujoco.mj_step`` of the same model with zero control. Target ratio >= 0.5.
+2. Video frames per second of the renderer used by ``cpgbiped render`` vs a bare
+   ``mujoco.Renderer`` loop over the same states with the same scene flags. Target >= 0.9x.
+3. Rollout time with the rerun recording written vs without. Target <= 1.1x.
+
+    MUJOCO_GL=osmesa python scripts/bench_physics.py [--seconds 20]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+import time
+
+os.environ.setdefault("MUJOCO_GL", "osmesa")
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+from envs.biped import rollout  # noqa: E402
+from envs.controller import GAIT_CONTROL, preset_network  # noqa: E402
+from models import BIPED_SCENE  # noqa: E402
+
+
+def best_of(n, f):
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        out = f()
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seconds", type=float, default=20.0)
+    ap.add_argument("--frames", type=int, default=150)
+    a = ap.parse_args(argv)
+    net, p = preset_network("walk"), GAIT_CONTROL["walk"]
+    rollout(net, p, 0.5)  # warm up (kernel cache, imports)
+
+    t_loop, rec = best_of(3, lambda: rollout(net, p, a.seconds))
+    n_steps = int(round(rec.t[-1] / rec.physics_dt))
+    m = mujoco.MjModel.from_xml_path(str(BIPED_SCENE))
+
+    def plain():
+        d = mujoco.MjData(m)
+        for _ in range(n_steps):
+            mujoco.mj_step(m, d)
+
+    t_plain, _ = best_of(3, plain)
+    print(f"1. physics, {n_steps} steps ({rec.t[-1]:.1f} s simulated, walk):")
+    print(f"   CPG + controller in the loop : {n_steps / t_loop:10.0f} steps/s")
+    print(f"   plain mj_step, zero control  : {n_steps / t_plain:10.0f} steps/s")
+    print(f"   ratio                        : {t_plain / t_loop:10.2f}   (target >= 0.5)")
+
+    from envs.render import FrameRenderer
+
+    rec = rollout(net, p, 6.0, record_qpos=True)
+    idx = np.linspace(0, len(rec.t) - 1, a.frames).astype(int)
+    with FrameRenderer(640, 480) as fr:
+        fr.frame(rec.qpos[0], rec.contact[0])
+        t_ours, _ = best_of(2, lambda: [fr.frame(rec.qpos[k], rec.contact[k]) for k in idx])
+    d = mujoco.MjData(m)
+    with mujoco.Renderer(m, 480, 640) as r:
+        opt = mujoco.MjvOption()
+        cam = mujoco.MjvCamera()  # the same view as the cpgbiped renderer
+        cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+        cam.distance, cam.elevation, cam.azimuth = 3.0, -8.0, 90.0
+        torso = m.body("torso").id
+
+        def bare():
+            for k in idx:
+                d.qpos[:] = rec.qpos[k]
+                mujoco.mj_forward(m, d)
+                cam.lookat[:] = [d.xpos[torso][0], 0.0, 0.6]
+                r.update_scene(d, cam, opt)
+                for flag in (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION,
+                             mujoco.mjtRndFlag.mjRND_SKYBOX):
+                    r.scene.flags[flag] = 0
+                r.render()
+
+        bare()
+        t_bare, _ = best_of(2, bare)
+    print(f"2. rendering {a.frames} frames at 640x480 (MUJOCO_GL={os.environ['MUJOCO_GL']}):")
+    print(f"   cpgbiped renderer            : {a.frames / t_ours:10.1f} frames/s")
+    print(f"   bare mujoco.Renderer loop    : {a.frames / t_bare:10.1f} frames/s")
+    print(f"   ratio                        : {t_bare / t_ours:10.2f}   (target >= 0.9)")
+
+    from envs.gait_metrics import measure
+    from envs.record import write_rrd
+
+    def without():
+        r_ = rollout(net, p, a.seconds)
+        return r_, measure(r_.t, r_.contact, r_.com_x, r_.fell_at, settle_s=2.0)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        def with_rrd():
+            r_, m_ = without()
+            write_rrd(os.path.join(tmp, "b.rrd"), {"walk": (r_, m_)})
+
+        t_without, _ = best_of(3, without)
+        t_with, _ = best_of(3, with_rrd)
+    print(f"3. rollout of {a.seconds:g} s with and without the rerun recording:")
+    print(f"   without                      : {t_without:10.2f} s")
+    print(f"   with .rrd                    : {t_with:10.2f} s")
+    print(f"   ratio                        : {t_with / t_without:10.2f}   (target <= 1.1)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
