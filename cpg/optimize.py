@@ -304,13 +304,13 @@ def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None
 
 
 def primary_names(gait: str) -> list[str]:
-    """Expand "all" to the four primary gaits; a clear error for unknown names."""
+    """Expand "all" to the four primary gaits; a clear error for unknown or secondary names."""
     if gait == "all":
         return list(PRIMARY)
-    return [gait_entry(gait).name] if gait_entry(gait).primary else _not_primary(gait)
-
-
-def _not_primary(gait):
-    raise InputError(f"{gait!r} is not a primary gait: optimize takes {', '.join(PRIMARY)} or all"
-                     f" (secondary gaits: {', '.join(n for n in GAITS if n not in PRIMARY)} via"
-                     f" 'cpgbiped secondary')")
+    g = gait_entry(gait)
+    if not g.primary:
+        raise InputError(f"{gait!r} is not a primary gait: optimize takes "
+                         f"{', '.join(PRIMARY)} or all (secondary gaits: "
+                         f"{', '.join(n for n in GAITS if n not in PRIMARY)} via "
+                         f"'cpgbiped secondary')")
+    return [g.name]

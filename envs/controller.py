@@ -19,7 +19,9 @@ Data flow per control tick (every ``control_every`` physics steps, ctrl held in 
    - swing hips place the foot: thigh angle in the world
      theta_sw = theta0 + c_v * v_com + c_d * (x_com - x_stance_ankle) (Raibert/SIMBICON);
    - knees: stance knees straighten (plus a push torque proportional to the extensor
-     activation), swing knees flex for clearance.
+     activation), swing knees flex for clearance; in two-legged gaits a foot still on the
+     ground when the extensors switch off crouches (knee to ``knee_swing``), loading the
+     next thrust.
 Sign conventions (see models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
 the leg forward; knee angle <= 0 (negative = flexed); ankle > 0 lifts the toes; torso pitch
 from the torso's up axis, > 0 leaning forward.
@@ -69,9 +71,9 @@ GAIT_CONTROL = {
     "walk": ControlParams(ankle_gain=0.0726, push=0.662, theta0=0.501, c_v=0.0631, c_d=0.681,
                           kp_t=1.01, kd_t=0.762, knee_swing=-0.912, time_scale=11.7,
                           pitch_d=0.148, kp_sw=2.08, kp_knee=3.4, swing_margin=0.25),
-    "run": ControlParams(ankle_gain=0.603, push=0.321, theta0=0.306, c_v=0.144, c_d=0.55,
-                         kp_t=5.99, kd_t=0.494, knee_swing=-1.27, time_scale=11.0, pitch_d=0.145,
-                         kp_sw=2.45, kp_knee=1.03),
+    "run": ControlParams(ankle_gain=0.582, push=0.302, theta0=0.284, c_v=0.155, c_d=0.533,
+                         kp_t=5.23, kd_t=0.448, knee_swing=-1.37, time_scale=11.6, pitch_d=0.123,
+                         kp_sw=2.34, kp_knee=1.49, swing_margin=-0.0386),
     "jump": ControlParams(two_legged=True, ankle_gain=0.35, push=0.5, theta0=0.48, c_v=0.13,
                           c_d=0.48, kp_t=1.97, kd_t=0.21, knee_swing=-0.9, time_scale=12.34,
                           pitch_d=0.2, kp_sw=3.94, kp_knee=2.32),
@@ -182,7 +184,10 @@ class CPGController:
         if n_support:
             tau_hip[support] = (tau_torso - tau_hip[~support].sum()) / n_support
         for i in range(2):
-            if stance[i]:
+            if p.two_legged and contact[i] and swing_cmd[i]:
+                # Load: on the ground with the extensors off, crouch for the next thrust.
+                k = p.kp_knee * (p.knee_swing - knee[i]) - p.kd_knee * knee_rate[i]
+            elif stance[i]:
                 k = p.kp_knee * (p.knee_stance - knee[i]) - p.kd_knee * knee_rate[i]
                 k += p.push * a[2 + i]
             else:

@@ -134,7 +134,11 @@ def _progress(desc: str, total: int, enabled: bool = True):
 
     bar = tqdm(total=total, desc=desc, unit="gen", leave=True, disable=not enabled,
                file=sys.stderr)
-    return bar, (lambda gen, n: (bar.update(gen - bar.n), None)[1])
+
+    def on_generation(gen: int, n: int) -> None:
+        bar.update(gen - bar.n)
+
+    return bar, on_generation
 
 
 def _evaluator(a):

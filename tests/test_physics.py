@@ -3,9 +3,11 @@
 Walk (issue criteria, 20 s after 2 s of settling): no fall; left-right lag 0.5 +- 0.1; duty
 factor >= 0.55 on both feet; double support > 5%; flight < 2%; >= 2 m; the contact-only
 classifier and the CPG classifier both name walk; from the Table 3 state, 10 random CPG
-states, and with floor friction x0.7 and x1.3. Run, jump and hop do not meet theirs yet
-(README, "Status of the physical gaits"): they are not asserted here beyond getting a
-verdict.
+states, and with floor friction x0.7 and x1.3.
+Run (issue criteria: no fall, lag 0.5 +- 0.1, duty < 0.5 on both feet, flight >= 10%, farther
+than walk, both classifiers agree): from the Table 3 state in full, and from at least 6 of 10
+random CPG states (the controller reaches 7-8 of 10 today; README lists what fails). Jump and
+hop are not reached yet: only that they get a verdict.
 """
 import shutil
 
@@ -38,6 +40,29 @@ def test_walk_from_cpg_states(seed):
 @pytest.mark.parametrize("friction", [0.7, 1.3])
 def test_walk_with_scaled_friction(friction):
     check_walk(validate("walk", seconds=20.0, friction_scale=friction).summary())
+
+
+def run_ok(s, walk_distance):
+    d = s["duty_factor"]
+    return (not s["fell"] and abs(s["lr_phase_lag"] - 0.5) <= 0.1 and max(d.values()) < 0.5
+            and s["flight"] >= 0.10 and s["distance_m"] > walk_distance
+            and s["physical_gait"] == "run" == s["cpg_gait"])
+
+
+@pytest.fixture(scope="module")
+def walk_distance():
+    return validate("walk", seconds=20.0).summary()["distance_m"]
+
+
+def test_run_from_table3_state(walk_distance):
+    s = validate("run", seconds=20.0).summary()
+    assert run_ok(s, walk_distance), s
+
+
+def test_run_from_random_cpg_states(walk_distance):
+    ok = [run_ok(validate("run", seconds=20.0, seed=k).summary(), walk_distance)
+          for k in range(10, 20)]
+    assert sum(ok) >= 6, ok
 
 
 def test_footfalls_follow_the_cpg_phase():
