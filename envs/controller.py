@@ -19,9 +19,7 @@ Data flow per control tick (every ``control_every`` physics steps, ctrl held in 
    - swing hips place the foot: thigh angle in the world
      theta_sw = theta0 + c_v * v_com + c_d * (x_com - x_stance_ankle) (Raibert/SIMBICON);
    - knees: stance knees straighten (plus a push torque proportional to the extensor
-     activation), swing knees flex for clearance; in two-legged gaits a foot still on the
-     ground when the extensors switch off crouches (knee to ``knee_swing``), loading the
-     next thrust.
+     activation), swing knees flex for clearance.
 Sign conventions (see models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
 the leg forward; knee angle <= 0 (negative = flexed); ankle > 0 lifts the toes; torso pitch
 from the torso's up axis, > 0 leaning forward.
@@ -184,10 +182,7 @@ class CPGController:
         if n_support:
             tau_hip[support] = (tau_torso - tau_hip[~support].sum()) / n_support
         for i in range(2):
-            if p.two_legged and contact[i] and swing_cmd[i]:
-                # Load: on the ground with the extensors off, crouch for the next thrust.
-                k = p.kp_knee * (p.knee_swing - knee[i]) - p.kd_knee * knee_rate[i]
-            elif stance[i]:
+            if stance[i]:
                 k = p.kp_knee * (p.knee_stance - knee[i]) - p.kd_knee * knee_rate[i]
                 k += p.push * a[2 + i]
             else:
