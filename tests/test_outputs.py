@@ -150,3 +150,20 @@ def test_demo_produces_everything(tmp_path):
     assert "walk_frame.png" in readme and "verdict" in readme
     summary = json.loads((out / "summary.json").read_text())
     assert set(summary["physics"]) == {"walk", "run", "jump", "hop"}
+
+
+def test_render_rrd_holds_the_video(tmp_path):
+    from rerun.chunk import RrdReader
+
+    r = cli("render", "--gait", "walk", "--seconds", "2", "--fps", "10", "--width", "160",
+            "--height", "120", "--out", str(tmp_path / "w.mp4"), "--rrd", str(tmp_path / "w.rrd"))
+    assert r.returncode == 0, r.stderr
+    kinds, frames = set(), 0
+    for chunk in RrdReader(str(tmp_path / "w.rrd")).store().stream():
+        if str(chunk.entity_path) == "/walk/video":
+            batch = chunk.to_record_batch()
+            kinds.update(batch.schema.names)
+            if "VideoFrameReference:timestamp" in batch.schema.names:
+                frames += batch.num_rows
+    assert "AssetVideo:blob" in kinds and frames == 20
+    assert "/walk/cpg/LF" in read_rrd(tmp_path / "w.rrd")
