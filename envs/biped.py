@@ -16,12 +16,12 @@ from dm_control.rl.control import PhysicsError
 from cpg.errors import InputError
 from models import BIPED_SCENE
 
-from .controller import CPGController, ControlParams, cpg_schedule
+from .controller import CONTACT_N, CPGController, ControlParams, cpg_schedule
 
 FALL_HEIGHT = 0.55  # torso (hip) height below which the biped has fallen (m); standing 0.86
 FALL_PITCH = 1.0  # |torso pitch| above which it has fallen (rad)
 # Any geom other than a foot touching the floor (a knee, a shank, the torso) is a fall too.
-CONTACT_FORCE_N = 1.0  # raw contact: sensor found a contact with at least this normal force
+CONTACT_FORCE_N = CONTACT_N  # raw contact: at least this normal force (N) on the foot
 
 
 class Physics(_Physics):
@@ -49,54 +49,65 @@ class Physics(_Physics):
                 com=sa("com_pos"), comvel=sa("com_vel"),
                 torso=m.body("torso").id,
                 feet=np.array([m.body("left_foot").id, m.body("right_foot").id]),
+                d=self.data.ptr,  # raw MjData: no wrapper overhead in the control loop
             )
         return self._ix
 
     def foot_forces(self) -> np.ndarray:
         """Normal ground reaction force on each foot (N), from the contact sensors."""
-        return np.abs(self.data.sensordata[self._index()["force"]])
+        ix = self._index()
+        return np.abs(ix["d"].sensordata[ix["force"]])
 
     def foot_contacts(self) -> np.ndarray:
         """Raw (not debounced) foot contact with the floor, (2,) bool."""
         return self.foot_forces() > CONTACT_FORCE_N
 
     def torso_height(self) -> float:
-        return float(self.data.xpos[self._index()["torso"], 2])
+        ix = self._index()
+        return float(ix["d"].xpos[ix["torso"], 2])
 
     def torso_pitch(self) -> float:
         """Forward lean of the torso (rad); the root hinge turns about 0 -1 0."""
-        return -float(self.data.qpos[self._index()["rooty_q"]])
+        ix = self._index()
+        return -float(ix["d"].qpos[ix["rooty_q"]])
 
     def torso_pitch_rate(self) -> float:
-        return -float(self.data.qvel[self._index()["rooty_v"]])
+        ix = self._index()
+        return -float(ix["d"].qvel[ix["rooty_v"]])
 
     def com_x(self) -> float:
-        return float(self.data.sensordata[self._index()["com"]])
+        ix = self._index()
+        return float(ix["d"].sensordata[ix["com"]])
 
     def com_velocity_x(self) -> float:
-        return float(self.data.sensordata[self._index()["comvel"]])
+        ix = self._index()
+        return float(ix["d"].sensordata[ix["comvel"]])
 
     def joint_angles(self) -> np.ndarray:
         """(6,) rad: left hip, knee, ankle, right hip, knee, ankle."""
-        return self.data.qpos[self._index()["joints_q"]].copy()
+        ix = self._index()
+        return ix["d"].qpos[ix["joints_q"]]
 
     def thigh_world_angles(self) -> np.ndarray:
         """Thigh angle from the vertical in the world, > 0 forward (rad)."""
         ix = self._index()
-        return self.data.qpos[ix["hips_q"]] + self.data.qpos[ix["rooty_q"]]
+        return ix["d"].qpos[ix["hips_q"]] + ix["d"].qpos[ix["rooty_q"]]
 
     def thigh_world_rates(self) -> np.ndarray:
         ix = self._index()
-        return self.data.qvel[ix["hips_v"]] + self.data.qvel[ix["rooty_v"]]
+        return ix["d"].qvel[ix["hips_v"]] + ix["d"].qvel[ix["rooty_v"]]
 
     def knee_angles(self) -> np.ndarray:
-        return self.data.qpos[self._index()["knees_q"]].copy()
+        ix = self._index()
+        return ix["d"].qpos[ix["knees_q"]]
 
     def knee_rates(self) -> np.ndarray:
-        return self.data.qvel[self._index()["knees_v"]].copy()
+        ix = self._index()
+        return ix["d"].qvel[ix["knees_v"]]
 
     def ankle_x(self, leg: int) -> float:
-        return float(self.data.xpos[self._index()["feet"][leg], 0])
+        ix = self._index()
+        return float(ix["d"].xpos[ix["feet"][leg], 0])
 
     def scale_friction(self, factor: float) -> None:
         if not (np.isfinite(factor) and factor > 0):
@@ -165,7 +176,9 @@ def rollout(network, params: ControlParams, seconds: float, *, seed: int | None 
         fell, unstable = None, None
         torso_id = m.body("torso").id
         floor = m.geom("floor").id
-        allowed = {floor, m.geom("left_foot").id, m.geom("right_foot").id}
+        not_foot = [True] * m.ngeom
+        for name in ("floor", "left_foot", "right_foot"):
+            not_foot[m.geom(name).id] = False
         push_tick = None if push is None else int(round(push[0] / (dt * control_every)))
         for k in range(n_ticks):
             t = d.time
@@ -178,9 +191,10 @@ def rollout(network, params: ControlParams, seconds: float, *, seed: int | None 
             if not np.all(np.isfinite(d.qpos)) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
                 unstable = f"physics became unstable at t={d.time:.3f} s"
                 break
+            forces = physics.foot_forces()
             rec["t"].append(d.time)
-            rec["contact"].append(physics.foot_contacts())
-            rec["force"].append(physics.foot_forces())
+            rec["contact"].append(forces > CONTACT_FORCE_N)
+            rec["force"].append(forces)
             rec["v"].append(ctrl.last_v)
             rec["a"].append(np.array(d.act[:4]))
             rec["joints"].append(physics.joint_angles())
@@ -190,9 +204,11 @@ def rollout(network, params: ControlParams, seconds: float, *, seed: int | None 
             rec["x"].append(physics.com_x())
             if record_qpos:
                 rec["qpos"].append(np.array(d.qpos))
-            pairs = d.contact.geom[:d.ncon]
-            body_down = any(g1 == floor and g2 not in allowed or g2 == floor and g1 not in allowed
-                            for g1, g2 in pairs)
+            body_down = False
+            for g1, g2 in d.contact.geom[:d.ncon].tolist():
+                if (g1 == floor and not_foot[g2]) or (g2 == floor and not_foot[g1]):
+                    body_down = True
+                    break
             if fell is None and (h < FALL_HEIGHT or abs(p) > FALL_PITCH or body_down):
                 fell = float(d.time)
                 if stop_on_fall:

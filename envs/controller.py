@@ -35,6 +35,7 @@ from cpg.errors import InputError
 from cpg.integrate import simulate_ml
 
 LEGS = ("left", "right")
+CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 
 
 @dataclass(frozen=True)
@@ -134,62 +135,67 @@ class CPGController:
         return self.t_model0 + self.p.time_scale * t_s
 
     def __call__(self, t_s: float) -> np.ndarray:
-        p, ph = self.p, self.phys
+        """The 8 controls at time t_s (s). Per-leg arithmetic on Python scalars: this runs
+        every control tick, where NumPy's per-call overhead would dominate."""
+        p, ph, st = self.p, self.phys, self.state
         v = self.sched.at(self.t_model(t_s))
         a = activation(v, p)  # LF, RF, LE, RE
         self.last_v, self.last_act = v, a
-        if p.two_legged:
-            swing_cmd = a[2:] < 0.5  # both legs together: extensors off
+        aE = (float(a[2]), float(a[3]))
+        if p.two_legged:  # both legs together: extensors off
+            swing_cmd = [aE[0] < 0.5, aE[1] < 0.5]
         else:  # alternating: the leg whose extensor is clearly the weaker one swings
-            swing_cmd = np.array([a[2] < a[3] - p.swing_margin, a[3] < a[2] - p.swing_margin])
-        contact = ph.foot_contacts()
-        st = self.state
+            swing_cmd = [aE[0] < aE[1] - p.swing_margin, aE[1] < aE[0] - p.swing_margin]
+        f = ph.foot_forces()
+        contact = [bool(f[0] > CONTACT_N), bool(f[1] > CONTACT_N)]
+        stance = [not swing_cmd[0], not swing_cmd[1]]
         if p.two_legged:
-            # Both legs together; a leg on the ground keeps stance until push-off lifts it.
-            stance = ~swing_cmd | contact
-            if swing_cmd.all() and contact.any():
-                stance = contact.copy()
+            # A leg on the ground keeps stance until push-off lifts it.
+            stance = [stance[i] or contact[i] for i in range(2)]
+            if all(swing_cmd) and any(contact):
+                stance = list(contact)
         else:
-            stance = ~swing_cmd
             for i in range(2):  # contact priority: never swing away the only support
                 if swing_cmd[i] and contact[i] and not contact[1 - i]:
                     stance[i] = True
-            if not stance.any():  # flight in a run: keep the leg commanded to stance
-                stance = ~swing_cmd
+            if not any(stance):  # flight in a run: keep the leg commanded to stance
+                stance = [not swing_cmd[0], not swing_cmd[1]]
         for i in range(2):
             if stance[i] and not st.stance[i]:
                 st.stance_x[i] = ph.ankle_x(i)
-        st.stance = stance
+        st.stance = np.array(stance)
 
         pitch, pitch_rate = ph.torso_pitch(), ph.torso_pitch_rate()
         com_x, com_v = ph.com_x(), ph.com_velocity_x()
-        thigh, thigh_rate = ph.thigh_world_angles(), ph.thigh_world_rates()
-        knee, knee_rate = ph.knee_angles(), ph.knee_rates()
-        u = np.zeros(8)
-        u[:4] = p.ankle_gain * a
-        tau_hip = np.zeros(2)
-        support = stance & contact  # only a foot on the ground can hold the torso
-        n_support = int(support.sum())
-        ref_x = st.stance_x[support].mean() if n_support else com_x
+        thigh, thigh_rate = ph.thigh_world_angles().tolist(), ph.thigh_world_rates().tolist()
+        knee, knee_rate = ph.knee_angles().tolist(), ph.knee_rates().tolist()
+        support = [stance[i] and contact[i] for i in range(2)]  # only a grounded foot holds the torso
+        n_support = support[0] + support[1]
+        ref_x = (sum(float(st.stance_x[i]) for i in range(2) if support[i]) / n_support
+                 if n_support else com_x)
+        tau_hip = [0.0, 0.0]
         for i in range(2):
             if not support[i]:
                 # Swing: place the foot; a stance-commanded foot in the air holds a landing pose.
-                target = p.theta0 + p.c_v * com_v + p.c_d * (com_x - ref_x) if not stance[i] \
+                target = (p.theta0 + p.c_v * com_v + p.c_d * (com_x - ref_x)) if not stance[i] \
                     else p.c_v * com_v
                 tau_hip[i] = p.kp_sw * (target - thigh[i]) - p.kd_sw * thigh_rate[i]
         # Hip torque on the thigh reacts on the torso: forward torso torque = +sum(tau_hip).
         tau_torso = p.kp_t * (p.pitch_d - pitch) - p.kd_t * pitch_rate
         if n_support:
-            tau_hip[support] = (tau_torso - tau_hip[~support].sum()) / n_support
+            share = (tau_torso - sum(tau_hip[i] for i in range(2) if not support[i])) / n_support
+            for i in range(2):
+                if support[i]:
+                    tau_hip[i] = share
+        u = np.empty(8)
+        u[:4] = p.ankle_gain * a
         for i in range(2):
             if stance[i]:
-                k = p.kp_knee * (p.knee_stance - knee[i]) - p.kd_knee * knee_rate[i]
-                k += p.push * a[2 + i]
+                k = p.kp_knee * (p.knee_stance - knee[i]) - p.kd_knee * knee_rate[i] + p.push * aE[i]
             else:
                 k = p.kp_knee * (p.knee_swing - knee[i]) - p.kd_knee * knee_rate[i]
-            u[6 + i] = k
-        u[4:6] = tau_hip
-        u[4:] = np.clip(u[4:], -1.0, 1.0)
+            u[4 + i] = min(1.0, max(-1.0, tau_hip[i]))
+            u[6 + i] = min(1.0, max(-1.0, k))
         return u
 
 

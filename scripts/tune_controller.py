@@ -15,7 +15,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-SPACE = dict(ankle_gain=(0.03, 0.7), push=(0.0, 0.7), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
+SPACE = dict(ankle_gain=(0.03, 1.0), push=(0.0, 1.0), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
              c_d=(0.0, 0.8), kp_t=(1.0, 6.0), kd_t=(0.1, 0.8), knee_swing=(-1.4, -0.3),
              time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0),
              swing_margin=(-0.4, 0.9))
