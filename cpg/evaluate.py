@@ -69,11 +69,44 @@ def _pattern_objectives(r, g: Gait) -> tuple[np.ndarray, float]:
     return np.array([phase_err, 180.0 * same_dist, 180.0 * max(diff_gap, 0.0)]), 0.0
 
 
+LOCK_TOL_DEG = 2.0
+
+
+def lock_time(t: np.ndarray, x: np.ndarray, g: Gait, period: float, t_end: float) -> float:
+    """Model time after which the rhythm stays locked to the gait: the start of the first
+    window (four periods long, stepped by one period) from which every later window has all
+    objectives below ``LOCK_TOL_DEG``. ``t_end`` when it never locks."""
+    if not np.isfinite(period) or period <= 0:
+        return t_end
+    starts = np.arange(t[0], t[-1] - 4 * period, period)
+    ok = []
+    for a in starts:
+        sel = (t >= a) & (t < a + 4 * period)
+        r = analyze(t[sel], x[sel], shape_tol=SHAPE_TOL, min_cycles=2)
+        ok.append(bool(r.oscillating and r.locked.all()
+                       and _pattern_objectives(r, g)[0].max() < LOCK_TOL_DEG))
+    ok = np.array(ok, dtype=bool)
+    if len(ok) == 0 or not ok[-1]:
+        return t_end
+    bad = np.nonzero(~ok)[0]
+    return float(starts[bad[-1] + 1]) if len(bad) else float(starts[0])
+
+
 def evaluate(gait: str, i_app, phi, W: np.ndarray, y0: np.ndarray,
-             s: SimSettings = SimSettings()) -> Evaluation:
-    """Objectives of directed weight matrices W (B, 4, 4) for a gait, one start state each."""
+             s: SimSettings = SimSettings(), with_lock_time: bool = False) -> Evaluation:
+    """Objectives of directed weight matrices W (B, 4, 4) for a gait, one start state each.
+
+    ``with_lock_time`` records from t = 0 and adds a fourth column: the time to lock (model
+    units, :func:`lock_time`; ``t_end`` for a failed set)."""
     g = gait_entry(gait)
-    tr = simulate_batch(i_app, phi, W, y0, s)
+    if with_lock_time:
+        tr_full = simulate_ml(i_app, phi, W, y0, t_end=s.t_end, dt=s.dt, t_record=0.0,
+                              record_every=s.record_every)
+        keep = tr_full.t >= s.t_settle
+        tr = Trajectory(tr_full.t[keep], tr_full.x[:, keep], tr_full.final, tr_full.diverged,
+                        tr_full.t_diverged)
+    else:
+        tr = simulate_batch(i_app, phi, W, y0, s)
     B = tr.x.shape[0]
     F = np.full((B, 3), WORST_DEG)
     G = np.ones(B)
@@ -95,7 +128,31 @@ def evaluate(gait: str, i_app, phi, W: np.ndarray, y0: np.ndarray,
         phases[b] = r.phases_deg
         F[b], G[b] = _pattern_objectives(r, g)
         reasons.append("ok" if G[b] <= 0 else "unequal waveforms")
+    if with_lock_time:
+        lock = np.full((B, 1), s.t_end)
+        for b in range(B):
+            if reasons[b] == "ok":
+                lock[b, 0] = lock_time(tr_full.t, tr_full.x[b], g,
+                                       analyze(tr.t, tr.x[b]).period, s.t_end)
+        F = np.concatenate([F, lock], axis=1)
     return Evaluation(F, G, reasons, names, phases)
+
+
+def with_robustness(ev_fn, gait: str, i_app, phi, W: np.ndarray, y0: np.ndarray,
+                    s: SimSettings, n_states: int, seed: int = 7, **kw) -> Evaluation:
+    """``ev_fn`` (``evaluate`` or a Dask evaluator) plus a last column 1 - robustness: the
+    fraction of ``n_states`` fixed random initial states that reach the gait, all in one batch."""
+    B = W.shape[0]
+    starts = np.vstack([np.broadcast_to(y0, (1, 8)), ml.random_states(n_states, seed)])
+    n = len(starts)
+    ev = ev_fn(gait, i_app, phi, np.repeat(W, n, axis=0), np.tile(starts, (B, 1)), s, **kw)
+    name = gait_entry(gait).name
+    reach = np.array([c == name for c in ev.classified]) & (ev.F[:, :3].max(axis=1) < LOCK_TOL_DEG)
+    frac = reach.reshape(B, n)[:, 1:].mean(axis=1)
+    main = np.arange(B) * n
+    return Evaluation(np.concatenate([ev.F[main], 1.0 - frac[:, None]], axis=1), ev.G[main],
+                      [ev.reasons[k] for k in main], [ev.classified[k] for k in main],
+                      ev.phases_deg[main])
 
 
 def robustness(gait: str, i_app, phi, W: np.ndarray, n_states: int = 50, seed: int = 1,

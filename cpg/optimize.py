@@ -27,7 +27,7 @@ from pymoo.core.problem import Problem
 
 from . import morris_lecar as ml
 from .errors import InputError
-from .evaluate import Evaluation, SimSettings, evaluate
+from .evaluate import Evaluation, SimSettings, evaluate, with_robustness
 from .gaits import GAITS, PRIMARY, gait as gait_entry
 from .io import atomic_path
 
@@ -84,22 +84,35 @@ class _BatchedProblem(Problem):
     y0: np.ndarray
     settings: SimSettings
 
-    def __init__(self, n_var, lo, hi, evaluator=None):
+    def __init__(self, n_var, lo, hi, evaluator=None, robust_states: int = 0,
+                 lock_time: bool = False):
         check_bounds(lo, hi)
-        super().__init__(n_var=n_var, n_obj=3, n_ieq_constr=1, xl=np.full(n_var, lo),
+        if int(robust_states) < 0:
+            raise InputError(f"robustness states must be >= 0, got {robust_states}")
+        self.robust_states, self.lock_time = int(robust_states), bool(lock_time)
+        n_obj = 3 + self.lock_time + (self.robust_states > 0)
+        super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=1, xl=np.full(n_var, lo),
                          xu=np.full(n_var, hi))
         self.evaluator = evaluator
         self.last: Evaluation | None = None
+
+    @property
+    def objective_names(self) -> list[str]:
+        return (["z_RF", "z_LE", "z_RE"] + (["lock_time"] if self.lock_time else [])
+                + (["1-robustness"] if self.robust_states else []))
 
     def matrices(self, X: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
     def _evaluate(self, X, out, *args, **kwargs):
         W = self.matrices(np.asarray(X, dtype=float))
-        if self.evaluator is None:
-            ev = evaluate(self.gait, self.i_app, self.phi, W, self.y0, self.settings)
+        fn = evaluate if self.evaluator is None else self.evaluator
+        kw = {"with_lock_time": True} if self.lock_time else {}
+        if self.robust_states:
+            ev = with_robustness(fn, self.gait, self.i_app, self.phi, W, self.y0, self.settings,
+                                 self.robust_states, **kw)
         else:
-            ev = self.evaluator(self.gait, self.i_app, self.phi, W, self.y0, self.settings)
+            ev = fn(self.gait, self.i_app, self.phi, W, self.y0, self.settings, **kw)
         self.last = ev
         out["F"] = ev.F
         out["G"] = ev.G[:, None]
@@ -115,14 +128,15 @@ class PrimaryGaitProblem(_BatchedProblem):
     """Variables (w_a, w_b, w_c) in [lo, hi]^3 for a primary gait (Table 2 I_app, phi)."""
 
     def __init__(self, gait: str, lo: float = -1.0, hi: float = 1.0,
-                 settings: SimSettings = SimSettings(), evaluator=None):
+                 settings: SimSettings = SimSettings(), evaluator=None, robust_states: int = 0,
+                 lock_time: bool = False):
         g = gait_entry(gait)
         if not g.primary:
             raise InputError(f"{g.name} is a secondary gait: search it by symmetry breaking")
         p = ml.preset(g.name)
         self.gait, self.i_app, self.phi, self.y0 = g.name, p.i_app, p.phi, p.y0
         self.settings = settings
-        super().__init__(3, lo, hi, evaluator)
+        super().__init__(3, lo, hi, evaluator, robust_states, lock_time)
 
     def matrices(self, X):
         return ml.weight_matrix(X)
@@ -164,9 +178,8 @@ class SymmetryBreakingProblem(_BatchedProblem):
 
 # ------------------------------------------------------------------------- Dask evaluation
 def _evaluate_chunk(args):
-    gait, i_app, phi, W, y0, settings = args
-    ev = evaluate(gait, i_app, phi, W, y0, settings)
-    return ev
+    gait, i_app, phi, W, y0, settings, kw = args
+    return evaluate(gait, i_app, phi, W, y0, settings, **kw)
 
 
 class DaskEvaluator:
@@ -192,11 +205,12 @@ class DaskEvaluator:
             raise InputError(f"cannot reach the Dask scheduler {address!r}: {e}") from None
         self.n_chunks = n_chunks or max(1, len(self.client.scheduler_info().get("workers", {})))
 
-    def __call__(self, gait, i_app, phi, W, y0, settings) -> Evaluation:
+    def __call__(self, gait, i_app, phi, W, y0, settings, **kw) -> Evaluation:
         chunks = np.array_split(np.arange(W.shape[0]), self.n_chunks)
         y0 = np.broadcast_to(y0, (W.shape[0], y0.shape[-1]))
         futures = self.client.map(_evaluate_chunk,
-                                  [(gait, i_app, phi, W[c], y0[c], settings) for c in chunks if len(c)],
+                                  [(gait, i_app, phi, W[c], y0[c], settings, kw)
+                                   for c in chunks if len(c)],
                                   pure=False)
         parts = self.client.gather(futures)
         return Evaluation(np.concatenate([p.F for p in parts]), np.concatenate([p.G for p in parts]),
@@ -273,6 +287,7 @@ def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None
     ``stop_after`` stops after that many generations of this call (to test resuming).
     """
     meta = {"problem": type(problem).__name__, "gait": problem.gait, "n_var": problem.n_var,
+            "n_obj": problem.n_obj,
             "xl": problem.xl.tolist(), "xu": problem.xu.tolist(), **asdict(rs),
             "settings": asdict(problem.settings)}
     meta.pop("checkpoint_every")

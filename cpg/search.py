@@ -83,10 +83,15 @@ def choose(X: np.ndarray, F: np.ndarray, robust_fn) -> tuple[int, np.ndarray]:
 
 def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1.0,
                      hi: float = 1.0, settings: SimSettings = SimSettings(), evaluator=None,
-                     progress=None, n_robust: int = 50, stop_after: int | None = None) -> dict:
-    """Run NSGA-II for one primary gait; write DIR/<gait>.json, CSVs and the front PNG."""
+                     progress=None, n_robust: int = 50, stop_after: int | None = None,
+                     robust_objective: int = 0, lock_objective: bool = False) -> dict:
+    """Run NSGA-II for one primary gait; write DIR/<gait>.json, CSVs and the front PNG.
+
+    ``robust_objective`` N > 0 adds the objective 1 - (fraction of N random initial states
+    reaching the gait); ``lock_objective`` adds the time to lock (model units)."""
     out = ensure_dir(out)
-    problem = PrimaryGaitProblem(gait, lo, hi, settings, evaluator)
+    problem = PrimaryGaitProblem(gait, lo, hi, settings, evaluator, robust_objective,
+                                 lock_objective)
     t0 = time.perf_counter()
     res = run(problem, rs, checkpoint=out / f".{gait}.checkpoint.pkl", on_generation=progress,
               stop_after=stop_after)
@@ -98,7 +103,7 @@ def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1
     rob_fn = lambda X: robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(X),  # noqa: E731
                                   n_states=20, seed=rs.seed + 1)
     Xf, Ff = res.X[feasible], res.F[feasible]
-    k, rob_pop = choose(Xf, Ff, rob_fn)
+    k, rob_pop = choose(Xf, Ff[:, :3], rob_fn)
     chosen_x, chosen_f = Xf[k], Ff[k]
     rob = np.array([rob_pop[np.nonzero(np.all(Xf == x, axis=1))[0][0]]
                     if np.any(np.all(Xf == x, axis=1)) else np.nan for x in ok])
@@ -110,13 +115,19 @@ def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1
     rob_paper = float(robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(paper_w),
                                  n_states=n_robust, seed=rs.seed + 2)[0])
     wall = time.perf_counter() - t0
-    point = lambda x, f, r: {"weights": np.round(x, 6).tolist(),  # noqa: E731
-                             "errors_deg": np.round(f, 6).tolist(),
-                             "robustness": None if not np.isfinite(r) else float(r)}
+    names = problem.objective_names
+
+    def point(x, f, r):
+        p = {"weights": np.round(x, 6).tolist(), "errors_deg": np.round(f[:3], 6).tolist(),
+             "robustness": None if not np.isfinite(r) else float(r)}
+        p.update({n: round(float(v), 6) for n, v in zip(names[3:], f[3:])})
+        return p
+
     result = {
         "format": FORMAT, "gait": gait, "i_app": problem.i_app, "phi": problem.phi,
         "settings": {"pop": rs.pop, "gens": rs.gens, "seed": rs.seed, "bounds": [lo, hi],
-                     "sim": settings.__dict__, "robustness_states": n_robust},
+                     "sim": settings.__dict__, "robustness_states": n_robust,
+                     "objectives": names},
         "chosen": point(chosen_x, chosen_f, rob_best),
         "pareto": [point(x, f, r) for x, f, r in zip(ok, F_opt, rob)],
         "paper": point(paper_w, ev_paper.F[0], rob_paper),
@@ -129,10 +140,10 @@ def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1
     _csv(out / f"{gait}_population.csv", head,
          [[*np.round(x, 6), *np.round(f, 6), round(float(g), 6), r, c]
           for x, f, g, r, c in zip(res.X, ev.F, ev.G, ev.reasons, ev.classified)])
-    _csv(out / f"{gait}_pareto.csv", ["w_a", "w_b", "w_c", "z_RF", "z_LE", "z_RE", "robustness"],
+    _csv(out / f"{gait}_pareto.csv", ["w_a", "w_b", "w_c", *names, "robustness"],
          [[*np.round(x, 6), *np.round(f, 6), "" if not np.isfinite(r) else r]
           for x, f, r in zip(ok, F_opt, rob)])
-    _plot_front(out / f"{gait}_pareto.png", res.F, F_opt,
+    _plot_front(out / f"{gait}_pareto.png", res.F[:, :3], F_opt[:, :3],
                 f"{gait}: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed {rs.seed}",
                 ("z_RF", "z_LE", "z_RE"))
     write_json(out / f"{gait}.json", result)

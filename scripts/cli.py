@@ -165,7 +165,9 @@ def cmd_optimize(a) -> int:
         for g in gaits_:
             bar, cb = _progress(f"NSGA-II {g}", rs.gens, not a.quiet)
             try:
-                results[g] = optimize_primary(g, rs, a.out, *a.bounds, SimSettings(), ev, cb)
+                results[g] = optimize_primary(g, rs, a.out, *a.bounds, SimSettings(), ev, cb,
+                                              robust_objective=a.robustness_objective,
+                                              lock_objective=a.lock_time_objective)
             finally:
                 bar.close()
     finally:
@@ -471,6 +473,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help="checkpoint interval in generations (default 5)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",
                     help="evaluate on Dask: a LocalCluster, or the scheduler at tcp://host:port")
+    sp.add_argument("--robustness-objective", type=int, default=0, metavar="N",
+                    help="add the objective 1 - fraction of N random initial states reaching "
+                         "the gait (N+1 integrations per individual)")
+    sp.add_argument("--lock-time-objective", action="store_true",
+                    help="add the objective: model time until the phases stay within 2 deg")
     sp.add_argument("--out", default="out/optimize", help="output folder (default out/optimize)")
     sp.add_argument("--quiet", action="store_true", help="no progress bar")
 

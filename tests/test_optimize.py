@@ -119,3 +119,29 @@ def test_bad_input(tmp_path):
     (tmp_path / "other.json").write_text('{"format": "something else"}')
     with pytest.raises(InputError, match="not a cpgbiped optimiser result"):
         load_result(tmp_path / "other.json")
+
+
+def test_lock_time_on_signals_that_lock_at_a_known_time():
+    """Synthetic 4 signals: RF in phase with LF until t=60, in antiphase (walk) after."""
+    from cpg.evaluate import lock_time
+    from cpg.gaits import gait
+
+    P = 5.0
+    t = np.arange(0.0, 200.0, 0.05)
+    y = lambda s: np.sin(2 * np.pi * s / P) + 0.3 * np.sin(4 * np.pi * s / P)  # noqa: E731
+    rf = np.where(t < 60.0, y(t), y(t + P / 2))
+    x = np.stack([y(t), rf, y(t + P / 2), y(t)], axis=1)
+    lock = lock_time(t, x, gait("walk"), P, 200.0)
+    assert 60.0 - P <= lock <= 60.0 + P
+
+
+def test_optional_objectives(tmp_path):
+    p = PrimaryGaitProblem("walk", settings=QUICK, robust_states=6, lock_time=True)
+    assert p.n_obj == 5 and p.objective_names[3:] == ["lock_time", "1-robustness"]
+    X = np.array([ml.preset("walk").weights, [-1.0, -1.0, -1.0]])
+    F = p.evaluate(X, return_as_dictionary=True)["F"]
+    assert 0.0 <= F[0, 3] <= QUICK.t_settle and F[0, 4] == 0.0  # the paper's walk: locks, robust
+    assert F[1, 3] == QUICK.t_end and F[1, 4] == 1.0  # diverges: worst on both
+    r = optimize_primary("hop", RunSettings(pop=8, gens=2, seed=0), tmp_path, settings=QUICK,
+                         robust_objective=4, lock_objective=True, n_robust=5)
+    assert {"lock_time", "1-robustness"} <= set(r["chosen"]) and len(r["chosen"]["errors_deg"]) == 3
