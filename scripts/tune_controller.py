@@ -18,7 +18,7 @@ import numpy as np
 SPACE = dict(ankle_gain=(0.03, 1.0), push=(0.0, 1.0), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
              c_d=(0.0, 0.8), kp_t=(1.0, 6.0), kd_t=(0.1, 0.8), knee_swing=(-1.4, -0.3),
              time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0),
-             swing_margin=(-0.4, 0.9))
+             swing_margin=(-0.4, 0.9), knee_stance=(-0.9, -0.02))
 KEYS = list(SPACE)
 
 
@@ -44,15 +44,34 @@ def cost(gait: str, m, seconds: float) -> float:
     return float(c + (0 if m.physical_gait == gait else 1.0))
 
 
+def parse_conditions(text: str) -> list[dict]:
+    """"table3,seed:11,friction:0.7" -> rollout keyword sets."""
+    out = []
+    for item in text.split(","):
+        if item == "table3":
+            out.append({})
+        elif item.startswith("seed:"):
+            out.append({"seed": int(item[5:])})
+        elif item.startswith("friction:"):
+            out.append({"friction_scale": float(item[9:])})
+        else:
+            raise SystemExit(f"unknown condition {item!r}")
+    return out
+
+
 def evaluate(args):
-    gait, x, seconds = args
+    """Mean cost over the conditions (each a rollout of ``seconds``)."""
+    gait, x, seconds, conditions = args
     from envs.biped import rollout
     from envs.controller import GAIT_CONTROL, preset_network, with_params
     from envs.gait_metrics import measure
 
     p = with_params(GAIT_CONTROL[gait], **dict(zip(KEYS, map(float, x))))
-    r = rollout(preset_network(gait), p, seconds)
-    return cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds)
+    costs = []
+    for kw in conditions:
+        r = rollout(preset_network(gait), p, seconds, **kw)
+        costs.append(cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds))
+    return float(np.mean(costs))
 
 
 def main(argv=None):
@@ -66,9 +85,12 @@ def main(argv=None):
     ap.add_argument("--gens", type=int, default=15)
     ap.add_argument("--seconds", type=float, default=12.0)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--conditions", default="table3",
+                    help="comma list of table3, seed:N, friction:F; fitness = mean cost")
     ap.add_argument("--start", action="store_true",
                     help="seed the first population with the gait's current preset")
     a = ap.parse_args(argv)
+    conds = parse_conditions(a.conditions)
     lo = np.array([SPACE[k][0] for k in KEYS])
     hi = np.array([SPACE[k][1] for k in KEYS])
     pool = ProcessPoolExecutor(2)
@@ -78,7 +100,8 @@ def main(argv=None):
             super().__init__(n_var=len(KEYS), n_obj=1, xl=lo, xu=hi)
 
         def _evaluate(self, X, out, *args, **kw):
-            out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds) for x in X])))
+            out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds, conds)
+                                                         for x in X])))
 
     sampling = None
     if a.start:  # the current preset plus random points around it
