@@ -4,7 +4,9 @@ The CPG (rhythm, leg timing) stays the paper's Table 2 network; only the control
 ``envs.controller.ControlParams`` are searched. Fitness (minimised) follows the acceptance
 criteria of the physical gaits (envs.gait_metrics): a fall costs 100 minus the seconds
 survived; otherwise the shortfalls from the gait's targets (left-right lag, duty factor,
-double support, flight, forward distance) are summed. Prints the best gains as Python.
+double support, flight, forward distance) are summed, plus the relative difference between
+the stride period and the CPG period / time scale (one stride per CPG cycle: the rhythm must
+be the CPG's, not a bounce of the body). Prints the best gains as Python.
 
     python scripts/tune_controller.py walk [--pop 24] [--gens 15] [--seconds 12]
 """
@@ -22,9 +24,15 @@ SPACE = dict(ankle_gain=(0.03, 1.0), push=(0.0, 1.0), theta0=(0.05, 0.6), c_v=(0
 KEYS = list(SPACE)
 
 
-def cost(gait: str, m, seconds: float) -> float:
+CPG_PERIOD = {"walk": 13.1126, "run": 8.8680, "jump": 11.9855, "hop": 7.9177}  # model units
+
+
+def cost(gait: str, m, seconds: float, time_scale: float) -> float:
     if m.fell:
         return 100.0 - (m.fell_at_s or 0.0)
+    # The rhythm must be the CPG's: one stride per CPG cycle.
+    expected = CPG_PERIOD[gait] / time_scale
+    rhythm = 4 * abs(m.stride_period_s - expected) / expected if np.isfinite(m.stride_period_s) else 4
     duty = np.array([m.duty_factor["left"], m.duty_factor["right"]])
     lag = m.lr_phase_lag if np.isfinite(m.lr_phase_lag) else 0.25
     sync = min(lag, 1 - lag)
@@ -41,7 +49,7 @@ def cost(gait: str, m, seconds: float) -> float:
     else:
         c = 4 * sync + 4 * max(0, 0.2 - m.flight) + 4 * max(0, duty.mean() - 0.40) + \
             max(0, 0.0 - d) * 0.2
-    return float(c + (0 if m.physical_gait == gait else 1.0))
+    return float(c + rhythm + (0 if m.physical_gait == gait else 1.0))
 
 
 def parse_conditions(text: str) -> list[dict]:
@@ -70,7 +78,8 @@ def evaluate(args):
     costs = []
     for kw in conditions:
         r = rollout(preset_network(gait), p, seconds, **kw)
-        costs.append(cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds))
+        costs.append(cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds,
+                          p.time_scale))
     return float(np.mean(costs))
 
 
