@@ -125,9 +125,6 @@ class CPGController:
         self.t_model0 = t_model0
         self.phys = physics
         self.state = ControllerState()
-        m = physics.model
-        self.act_ids = [m.name2id(n, "actuator") for n in
-                        ("LF", "RF", "LE", "RE", "left_hip", "right_hip", "left_knee", "right_knee")]
         self.last_v = np.zeros(4)
         self.last_act = np.zeros(4)
 

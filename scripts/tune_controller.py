@@ -13,6 +13,7 @@ be the CPG's, not a bounce of the body). Prints the best gains as Python.
 from __future__ import annotations
 
 import argparse
+import functools
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
@@ -24,14 +25,19 @@ SPACE = dict(ankle_gain=(0.03, 1.0), push=(0.0, 1.0), theta0=(0.05, 0.6), c_v=(0
 KEYS = list(SPACE)
 
 
-CPG_PERIOD = {"walk": 13.1126, "run": 8.8680, "jump": 11.9855, "hop": 7.9177}  # model units
+@functools.cache
+def cpg_period(gait: str) -> float:
+    """The preset's CPG period (model units), from the network alone."""
+    from cpg.reproduce import run_preset
+
+    return run_preset(gait).rhythm.period
 
 
 def cost(gait: str, m, seconds: float, time_scale: float) -> float:
     if m.fell:
         return 100.0 - (m.fell_at_s or 0.0)
     # The rhythm must be the CPG's: one stride per CPG cycle.
-    expected = CPG_PERIOD[gait] / time_scale
+    expected = cpg_period(gait) / time_scale
     rhythm = 4 * abs(m.stride_period_s - expected) / expected if np.isfinite(m.stride_period_s) else 4
     duty = np.array([m.duty_factor["left"], m.duty_factor["right"]])
     lag = m.lr_phase_lag if np.isfinite(m.lr_phase_lag) else 0.25

@@ -65,11 +65,19 @@ def test_run_from_random_cpg_states(walk_distance):
     assert sum(ok) >= 6, ok
 
 
-def test_footfalls_follow_the_cpg_phase():
+@pytest.fixture(scope="module")
+def walk_cpg_period():
+    """The walk preset's CPG period (model units), from the network alone (no physics)."""
+    from cpg.reproduce import run_preset
+
+    return run_preset("walk").rhythm.period
+
+
+def test_footfalls_follow_the_cpg_phase(walk_cpg_period):
     """Advance the CPG by half its period: left touchdowns move by half a stride."""
     p = GAIT_CONTROL["walk"]
     net = preset_network("walk")
-    period_model = 13.1126  # walk preset period (model units), measured in tests/test_paper.py
+    period_model = walk_cpg_period
     strides = []
     for t0 in (0.0, period_model / 2):
         r = rollout(net, p, 12.0, t_model0=t0)
@@ -81,10 +89,10 @@ def test_footfalls_follow_the_cpg_phase():
     assert abs(abs(shift / (2 * np.pi)) - 0.5) < 0.15
 
 
-def test_cpg_rhythm_sets_stride_period():
+def test_cpg_rhythm_sets_stride_period(walk_cpg_period):
     """Stride period (s) = CPG period (model units) / time scale (units per second)."""
     v = validate("walk", seconds=20.0)
-    expected = 13.1126 / GAIT_CONTROL["walk"].time_scale
+    expected = walk_cpg_period / GAIT_CONTROL["walk"].time_scale
     assert v.metrics.stride_period_s == pytest.approx(expected, rel=0.03)
 
 
