@@ -183,7 +183,3 @@ def analyze(t: np.ndarray, x: np.ndarray, *, shape_tol: float = 0.05, min_cycles
     pair[:, ~locked] = np.nan
     return Rhythm(True, "", float(period), k, phases, pair, locked, dist, equal, amp, cycle)
 
-
-def steady_window(t: np.ndarray, fraction: float = 0.5) -> np.ndarray:
-    """Boolean mask of the last ``fraction`` of a recording (the steady state)."""
-    return t >= t[0] + (1.0 - fraction) * (t[-1] - t[0])

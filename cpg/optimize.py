@@ -18,7 +18,7 @@ right (LF<->RF, LE<->RE), "horizontal" swaps flexor and extensor (LF<->LE, RF<->
 from __future__ import annotations
 
 import pickle
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -249,7 +249,6 @@ class RunResult:
     pareto_F: np.ndarray
     n_gen: int
     resumed_from: int | None = None
-    history: list = field(default_factory=list)
 
 
 def _algorithm(pop: int):

@@ -26,7 +26,7 @@ from the torso's up axis, > 0 leaning forward.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -34,7 +34,6 @@ from cpg import morris_lecar as ml
 from cpg.errors import InputError
 from cpg.integrate import simulate_ml
 
-LEGS = ("left", "right")
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 
 
@@ -126,7 +125,6 @@ class CPGController:
         self.phys = physics
         self.state = ControllerState()
         self.last_v = np.zeros(4)
-        self.last_act = np.zeros(4)
 
     def t_model(self, t_s: float) -> float:
         return self.t_model0 + self.p.time_scale * t_s
@@ -137,7 +135,7 @@ class CPGController:
         p, ph, st = self.p, self.phys, self.state
         v = self.sched.at(self.t_model(t_s))
         a = activation(v, p)  # LF, RF, LE, RE
-        self.last_v, self.last_act = v, a
+        self.last_v = v
         aE = (float(a[2]), float(a[3]))
         if p.two_legged:  # both legs together: extensors off
             swing_cmd = [aE[0] < 0.5, aE[1] < 0.5]
@@ -194,10 +192,6 @@ class CPGController:
             u[4 + i] = min(1.0, max(-1.0, tau_hip[i]))
             u[6 + i] = min(1.0, max(-1.0, k))
         return u
-
-
-def with_params(base: ControlParams, **kw) -> ControlParams:
-    return replace(base, **kw)
 
 
 def preset_network(gait: str):

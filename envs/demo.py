@@ -1,7 +1,6 @@
 """The main job: CPG reproduction, then every primary gait validated, rendered and logged."""
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np

@@ -121,7 +121,6 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
     contact = np.asarray(contact, dtype=bool)
     com_x = np.asarray(com_x, dtype=float)
     if len(t) < 2:
-        c = np.zeros((0, 2), bool)
         return GaitMetrics(fell_at is not None, fell_at, {"left": float("nan"), "right": float("nan")},
                            float("nan"), float("nan"), float("nan"), float("nan"), 0.0, 0.0,
                            {"left": [], "right": []}, {"left": [], "right": []}, "none")

@@ -38,7 +38,6 @@ class CPGLocomotion(base.Task):
         self.random_cpg_state = random_cpg_state
         self.friction_scale = friction_scale
         self.controller: CPGController | None = None
-        self._residual = np.zeros(8)
 
     def initialize_episode(self, physics: Physics):
         if self.friction_scale != 1.0 and not getattr(physics, "_friction_scaled", False):
@@ -52,8 +51,7 @@ class CPGLocomotion(base.Task):
         super().initialize_episode(physics)
 
     def before_step(self, action, physics: Physics):
-        self._residual = np.asarray(action, dtype=float)
-        u = self.controller(physics.data.time) + self._residual
+        u = self.controller(physics.data.time) + np.asarray(action, dtype=float)
         lo, hi = physics.model.actuator_ctrlrange.T
         physics.set_control(np.clip(u, lo, hi))
 

@@ -77,10 +77,12 @@ def evaluate(args):
     """Mean cost over the conditions (each a rollout of ``seconds``)."""
     gait, x, seconds, conditions = args
     from envs.biped import rollout
-    from envs.controller import GAIT_CONTROL, preset_network, with_params
+    from dataclasses import replace
+
+    from envs.controller import GAIT_CONTROL, preset_network
     from envs.gait_metrics import measure
 
-    p = with_params(GAIT_CONTROL[gait], **dict(zip(KEYS, map(float, x))))
+    p = replace(GAIT_CONTROL[gait], **dict(zip(KEYS, map(float, x))))
     costs = []
     for kw in conditions:
         r = rollout(preset_network(gait), p, seconds, **kw)

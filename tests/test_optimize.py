@@ -6,7 +6,7 @@ import pytest
 
 from cpg import morris_lecar as ml
 from cpg.errors import InputError
-from cpg.evaluate import SimSettings, evaluate, robustness
+from cpg.evaluate import SimSettings, robustness
 from cpg.optimize import (REFLECTIONS, PrimaryGaitProblem, RunSettings, SymmetryBreakingProblem,
                           load_checkpoint, orbits, run)
 from cpg.search import load_result, optimize_primary

@@ -8,7 +8,7 @@ import mediapy
 import numpy as np
 import pytest
 
-from envs.gait_metrics import debounce, edges
+from envs.gait_metrics import edges
 from envs.record import read_rrd
 from envs.validate import validate
 from scripts.cli import main
