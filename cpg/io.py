@@ -81,3 +81,13 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
 
 def write_json(path: str | os.PathLike, obj) -> Path:
     return write_text(path, to_json(obj) + "\n")
+
+
+def format_table(rows: list[list], header: list[str]) -> str:
+    """A right-aligned plain-text table with a dashed rule under the header."""
+    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
+
+    def line(r):
+        return "  ".join(str(c).rjust(w) for c, w in zip(r, widths))
+
+    return "\n".join([line(header), line(["-" * w for w in widths])] + [line(r) for r in rows])

@@ -45,3 +45,13 @@ def run_preset(gait: str, y0: np.ndarray | None = None, t_end: float = T_END,
 
 def reproduce(gaits=ml.PRIMARY_GAITS, **kw) -> dict[str, GaitResult]:
     return {g: run_preset(g, **kw) for g in gaits}
+
+
+def table(summaries: dict[str, dict]) -> str:
+    """The reproduction as text, from ``GaitResult.summary()`` per gait."""
+    from .io import format_table
+
+    rows = [[g, f"{s['period']:.3f}", *(f"{s['phases_deg'][c]:.2f}" for c in ("RF", "LE", "RE")),
+             "yes" if s["waveforms_equal"] else "no", s["classified_as"]]
+            for g, s in summaries.items()]
+    return format_table(rows, ["gait", "period", "RF", "LE", "RE", "same wave", "classified"])

@@ -25,11 +25,10 @@ def run_demo(out: str = "out/demo", seconds: float = 20.0, video_seconds: float 
     from tqdm import tqdm
 
     from cpg.plots import plot_gait_signals
-    from cpg.reproduce import reproduce
+    from cpg.reproduce import reproduce, table
     from envs.record import write_rrd
     from envs.render import FrameRenderer, check_backend, gait_diagram, render_video, signals_picture
-    from envs.validate import validate
-    from scripts.cli import _fmt_table, _metrics_rows
+    from envs.validate import metrics_table, validate
 
     out = ensure_dir(out)
     check_backend()
@@ -38,10 +37,8 @@ def run_demo(out: str = "out/demo", seconds: float = 20.0, video_seconds: float 
 
     bar.set_description(steps[0])
     rep = reproduce()
-    cpg_rows = [[g, f"{r.rhythm.period:.3f}",
-                 *(f"{r.rhythm.phases_deg[k]:.2f}" for k in (1, 2, 3)),
-                 "yes" if r.rhythm.all_equal else "no", r.classified_as] for g, r in rep.items()]
-    cpg_table = _fmt_table(cpg_rows, ["gait", "period", "RF", "LE", "RE", "same wave", "classified"])
+    cpg_summary = {g: r.summary() for g, r in rep.items()}
+    cpg_table = table(cpg_summary)
     plot_gait_signals({g: (r.trajectory.t, r.trajectory.x[0], f"Table 2 weights {ml.preset(g).weights}")
                        for g, r in rep.items()}, out / "cpg_signals.png")
     bar.update()
@@ -75,9 +72,8 @@ def run_demo(out: str = "out/demo", seconds: float = 20.0, video_seconds: float 
     bar.update()
     bar.close()
 
-    phys_table = _metrics_rows(summaries)
-    write_json(out / "summary.json", {"cpg": {g: r.summary() for g, r in rep.items()},
-                                      "physics": summaries})
+    phys_table = metrics_table(summaries)
+    write_json(out / "summary.json", {"cpg": cpg_summary, "physics": summaries})
     md = ["# cpgbiped demo", "",
           "## 1. The paper's four gaits in the 4-cell Morris-Lecar network", "",
           "Table 2 weights from Table 3 states; phases of RF, LE, RE behind LF (degrees).", "",

@@ -66,3 +66,18 @@ def validate(gait: str, weights=None, seconds: float = 20.0, seed: int | None = 
     steady = rec.t >= settle_s
     cpg_name = classify(rec.t[steady], rec.cpg_v[steady])[0] if steady.sum() > 16 else "none"
     return Validation(gait, rec, m, cpg_name)
+
+
+def metrics_table(summaries: dict[str, dict]) -> str:
+    """Physical metrics and verdicts as text, from ``Validation.summary()`` per rollout."""
+    from cpg.io import format_table
+
+    rows = []
+    for name, s in summaries.items():
+        d = s["duty_factor"]
+        rows.append([name, "yes" if s["fell"] else "no", f"{d['left']:.2f}/{d['right']:.2f}",
+                     f"{s['lr_phase_lag']:.2f}", f"{s['double_support']:.2f}", f"{s['flight']:.2f}",
+                     f"{s['stride_period_s']:.2f}", f"{s['distance_m']:.2f}",
+                     s["physical_gait"], s["cpg_gait"], "PASS" if s["passed"] else "fail"])
+    return format_table(rows, ["rollout", "fell", "duty L/R", "L-R lag", "double", "flight",
+                               "stride s", "dist m", "physical", "cpg", "verdict"])

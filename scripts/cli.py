@@ -46,16 +46,10 @@ def _fail(msg: str) -> int:
     return 2
 
 
-def _fmt_table(rows: list[list[str]], header: list[str]) -> str:
-    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
-    line = lambda r: "  ".join(str(c).rjust(w) for c, w in zip(r, widths))  # noqa: E731
-    return "\n".join([line(header), line(["-" * w for w in widths])] + [line(r) for r in rows])
-
-
 # ---------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(a) -> int:
     from cpg import io, morris_lecar as ml
-    from cpg.reproduce import reproduce
+    from cpg.reproduce import reproduce, table
 
     results = reproduce(dt=a.dt)
     summary = {g: r.summary() for g, r in results.items()}
@@ -72,13 +66,8 @@ def cmd_reproduce(a) -> int:
     if a.json:
         print(io.to_json(summary))
         return 0
-    rows = []
-    for g, s in summary.items():
-        ph = s["phases_deg"]
-        rows.append([g, f"{s['period']:.3f}", *(f"{ph[c]:.2f}" for c in ("RF", "LE", "RE")),
-                     "yes" if s["waveforms_equal"] else "no", s["classified_as"]])
     print("Paper's Table 2 presets from Table 3 states (phases of RF, LE, RE vs LF, degrees):")
-    print(_fmt_table(rows, ["gait", "period", "RF", "LE", "RE", "same wave", "classified"]))
+    print(table(summary))
     return 0
 
 
@@ -106,7 +95,7 @@ def cmd_matsuoka(a) -> int:
              " ".join(f"{f:.3f}" for f in v["pair_frequency_hz"].values()),
              " ".join(f"{p:.1f}" for p in v["lr_phase_deg"].values())] for k, v in out.items()]
     print("Matsuoka 12-neuron network (joint pair = extensor - flexor drive):")
-    print(_fmt_table(rows, ["parameter set", "tau s", "T s", "r", "freq Hz",
+    print(io.format_table(rows, ["parameter set", "tau s", "T s", "r", "freq Hz",
                             "pair rates Hz (L hip..R ankle)", "L/R phase hip knee ankle"]))
     return 0
 
@@ -253,21 +242,9 @@ def _input_error(msg):
     return InputError(msg)
 
 
-def _metrics_rows(summaries: dict) -> str:
-    rows = []
-    for name, s in summaries.items():
-        d = s["duty_factor"]
-        rows.append([name, "yes" if s["fell"] else "no", f"{d['left']:.2f}/{d['right']:.2f}",
-                     f"{s['lr_phase_lag']:.2f}", f"{s['double_support']:.2f}", f"{s['flight']:.2f}",
-                     f"{s['stride_period_s']:.2f}", f"{s['distance_m']:.2f}",
-                     s["physical_gait"], s["cpg_gait"], "PASS" if s["passed"] else "fail"])
-    return _fmt_table(rows, ["rollout", "fell", "duty L/R", "L-R lag", "double", "flight",
-                             "stride s", "dist m", "physical", "cpg", "verdict"])
-
-
 def cmd_validate(a) -> int:
     from cpg import io
-    from envs.validate import validate
+    from envs.validate import metrics_table, validate
 
     gait, w, src = _weights_arg(a)
     v = validate(gait, w, a.seconds, a.seed, a.friction_scale, _push(a))
@@ -282,7 +259,7 @@ def cmd_validate(a) -> int:
     else:
         print(f"{gait} ({src}), {a.seconds:g} s after {2.0:g} s settling"
               + (f", friction x{a.friction_scale:g}" if a.friction_scale != 1 else ""))
-        print(_metrics_rows({gait: s}))
+        print(metrics_table({gait: s}))
         if s["unstable"]:
             print(f"physics: {s['unstable']}")
     return 0
