@@ -138,6 +138,12 @@ def evaluate(gait: str, i_app, phi, W: np.ndarray, y0: np.ndarray,
     return Evaluation(F, G, reasons, names, phases)
 
 
+def reached(ev: Evaluation, gait: str, tol_deg: float = LOCK_TOL_DEG) -> np.ndarray:
+    """Per member: the classifier names the gait and every phase objective is below tol_deg."""
+    name = gait_entry(gait).name
+    return np.array([c == name for c in ev.classified]) & (ev.F[:, :3].max(axis=1) < tol_deg)
+
+
 def with_robustness(ev_fn, gait: str, i_app, phi, W: np.ndarray, y0: np.ndarray,
                     s: SimSettings, n_states: int, seed: int = 7, **kw) -> Evaluation:
     """``ev_fn`` (``evaluate`` or a Dask evaluator) plus a last column 1 - robustness: the
@@ -146,9 +152,7 @@ def with_robustness(ev_fn, gait: str, i_app, phi, W: np.ndarray, y0: np.ndarray,
     starts = np.vstack([np.broadcast_to(y0, (1, 8)), ml.random_states(n_states, seed)])
     n = len(starts)
     ev = ev_fn(gait, i_app, phi, np.repeat(W, n, axis=0), np.tile(starts, (B, 1)), s, **kw)
-    name = gait_entry(gait).name
-    reach = np.array([c == name for c in ev.classified]) & (ev.F[:, :3].max(axis=1) < LOCK_TOL_DEG)
-    frac = reach.reshape(B, n)[:, 1:].mean(axis=1)
+    frac = reached(ev, gait).reshape(B, n)[:, 1:].mean(axis=1)
     main = np.arange(B) * n
     return Evaluation(np.concatenate([ev.F[main], 1.0 - frac[:, None]], axis=1), ev.G[main],
                       [ev.reasons[k] for k in main], [ev.classified[k] for k in main],
@@ -166,5 +170,4 @@ def robustness(gait: str, i_app, phi, W: np.ndarray, n_states: int = 50, seed: i
     Wb = np.repeat(W, n_states, axis=0)
     yb = np.tile(y0, (P, 1))
     ev = evaluate(gait, i_app, phi, Wb, yb, s)
-    ok = np.array([c == gait_entry(gait).name for c in ev.classified]) & (ev.F.max(axis=1) < tol_deg)
-    return ok.reshape(P, n_states).mean(axis=1)
+    return reached(ev, gait, tol_deg).reshape(P, n_states).mean(axis=1)

@@ -105,8 +105,8 @@ def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1
     Xf, Ff = res.X[feasible], res.F[feasible]
     k, rob_pop = choose(Xf, Ff[:, :3], rob_fn)
     chosen_x, chosen_f = Xf[k], Ff[k]
-    rob = np.array([rob_pop[np.nonzero(np.all(Xf == x, axis=1))[0][0]]
-                    if np.any(np.all(Xf == x, axis=1)) else np.nan for x in ok])
+    rob_by_x = {tuple(x): r for x, r in zip(Xf, rob_pop)}  # Pareto points are population members
+    rob = np.array([rob_by_x.get(tuple(x), np.nan) for x in ok])
     rob_best = float(robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(chosen_x),
                                 n_states=n_robust, seed=rs.seed + 2)[0])
     paper_w = np.array(ml.preset(gait).weights)

@@ -83,12 +83,13 @@ class FrameRenderer:
         self.cam.distance, self.cam.elevation, self.cam.azimuth = 3.0, -8.0, 90.0
         self.fancy = fancy
         self.foot_ids = [self.model.body("left_foot").id, self.model.body("right_foot").id]
+        self.torso_id = self.model.body("torso").id
 
     def frame(self, qpos: np.ndarray, stance=None) -> np.ndarray:
         mj = self.mujoco
         self.data.qpos[:] = qpos
         mj.mj_forward(self.model, self.data)
-        torso = self.data.xpos[self.model.body("torso").id]
+        torso = self.data.xpos[self.torso_id]
         self.cam.lookat[:] = [torso[0], 0.0, 0.6]
         self.renderer.update_scene(self.data, self.cam)
         scn = self.renderer.scene

@@ -173,7 +173,7 @@ def cmd_optimize(a) -> int:
 
 def cmd_secondary(a) -> int:
     from cpg import io, morris_lecar as ml
-    from cpg.optimize import RunSettings
+    from cpg.optimize import SECONDARY_TARGETS, RunSettings
     from cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
     rs = RunSettings(a.pop, a.gens, a.seed)
@@ -189,16 +189,14 @@ def cmd_secondary(a) -> int:
         f"{g} {'(optimiser)' if g in primary else '(paper)'}" for g in weights), file=sys.stderr)
     ev = _evaluator(a)
     try:
-        bar, cb = _progress("symmetry breaking", 0, not a.quiet)
-        bar.total = rs.gens
-        done = {"n": 0}
+        bar, advance = _progress("symmetry breaking", rs.gens, not a.quiet)
+        target = iter(range(1, len(SECONDARY_TARGETS) + 1))
 
-        def prog(gen, n):
+        def prog(gen, n):  # one bar, reset for each target
             if gen == 1:
-                done["n"] += 1
                 bar.reset(total=n)
-                bar.set_description(f"target {done['n']}/8")
-            bar.update(gen - bar.n)
+                bar.set_description(f"target {next(target)}/{len(SECONDARY_TARGETS)}")
+            advance(gen, n)
 
         results = secondary_all(weights, rs, evaluator=ev, progress=prog)
         bar.close()
@@ -206,8 +204,7 @@ def cmd_secondary(a) -> int:
         if ev is not None:
             ev.close()
     write_secondary(a.out, results)
-    table = comparison_markdown(primary, results) if len(primary) == 4 else \
-        comparison_markdown({}, results)
+    table = comparison_markdown(primary if len(primary) == 4 else {}, results)
     io.write_text(os.path.join(a.out, "comparison.md"), table)
     print(table)
     return 0
