@@ -5,17 +5,19 @@ controller's ``time_scale``.
 """
 from __future__ import annotations
 
+import copy
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
 from dm_control.mujoco import Physics as _Physics
-from dm_control.rl.control import PhysicsError
 
 from cpg.errors import InputError
 from models import BIPED_SCENE
 
+from . import control_kernel as kernel
 from .controller import CONTACT_N, CPGController, ControlParams, cpg_schedule
 
 FALL_HEIGHT = 0.55  # torso (hip) height below which the biped has fallen (m); standing 0.86
@@ -110,21 +112,43 @@ class Physics(_Physics):
         return float(ix["d"].xpos[ix["feet"][leg], 0])
 
     def scale_friction(self, factor: float) -> None:
-        if not (np.isfinite(factor) and factor > 0):
-            raise InputError(f"friction scale must be a positive number, got {factor}")
-        self.model.geom_friction[:, 0] *= factor
+        scale_friction(self.model.ptr, factor)
+
+
+def scale_friction(model: mujoco.MjModel, factor: float) -> None:
+    """Scale every geom's sliding friction by ``factor`` (> 0)."""
+    if not (np.isfinite(factor) and factor > 0):
+        raise InputError(f"friction scale must be a positive number, got {factor}")
+    model.geom_friction[:, 0] *= factor
 
 
 def load_physics(xml_path: str | Path = BIPED_SCENE) -> Physics:
-    """The biped scene; a broken or missing MJCF gives a one-line InputError."""
+    """The biped scene as a dm_control Physics; a broken or missing MJCF gives a one-line
+    InputError."""
+    return Physics.from_model(_wrap(load_model(xml_path)))
+
+
+def _wrap(model: mujoco.MjModel):
+    from dm_control.mujoco.wrapper import MjModel
+
+    return MjModel(model)
+
+
+def load_model(xml_path: str | Path = BIPED_SCENE) -> mujoco.MjModel:
+    """A fresh copy of the compiled scene (the parsed model is cached per file and mtime)."""
     path = Path(xml_path)
     if not path.exists():
         raise InputError(f"MJCF file {str(path)!r} does not exist")
+    return copy.copy(_compiled(str(path.resolve()), path.stat().st_mtime_ns))
+
+
+@functools.lru_cache(maxsize=8)
+def _compiled(path: str, mtime_ns: int) -> mujoco.MjModel:
     try:
-        return Physics.from_xml_path(str(path))
+        return mujoco.MjModel.from_xml_path(path)
     except Exception as e:  # mujoco raises ValueError with the parser's message
         msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise InputError(f"cannot load MJCF {str(path)!r}: {msg}") from None
+        raise InputError(f"cannot load MJCF {path!r}: {msg}") from None
 
 
 @dataclass
@@ -163,62 +187,51 @@ def rollout(network, params: ControlParams, seconds: float, *, seed: int | None 
         from cpg.morris_lecar import random_states
 
         y0 = random_states(1, seed)[0]
-    physics = load_physics(xml_path)
+    m = load_model(xml_path)
+    if friction_scale != 1.0:
+        scale_friction(m, friction_scale)
+    d = mujoco.MjData(m)
     try:
-        if friction_scale != 1.0:
-            physics.scale_friction(friction_scale)
         sched = cpg_schedule(i_app, phi, W, y0, t_model0 + params.time_scale * seconds + 1.0)
-        ctrl = CPGController(physics, sched, params, t_model0)
-        m, d = physics.model.ptr, physics.data.ptr
+        ctrl = CPGController(m, d, sched, params, t_model0)
         dt = m.opt.timestep
         n_ticks = int(round(seconds / (dt * control_every)))
-        rec = {k: [] for k in ("t", "contact", "force", "v", "a", "joints", "h", "pitch", "x", "qpos")}
-        fell, unstable = None, None
+        rec = np.zeros((n_ticks, kernel.R_SIZE))
+        qpos_rec = np.zeros((n_ticks if record_qpos else 0, m.nq))
+        fell, unstable, n = None, None, 0
         torso_id = m.body("torso").id
-        floor = m.geom("floor").id
-        not_foot = [True] * m.ngeom
-        for name in ("floor", "left_foot", "right_foot"):
-            not_foot[m.geom(name).id] = False
+        qpos, qvel, sens, xpos, act, ctrl_in = d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl
+        ix, u, v = ctrl.ix, ctrl.u, ctrl.last_v
+        bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
         push_tick = None if push is None else int(round(push[0] / (dt * control_every)))
         for k in range(n_ticks):
-            t = d.time
-            u = ctrl(t)
-            d.ctrl[:] = u
-            if push_tick is not None and k == push_tick:  # impulse = force x duration
+            kernel.control(d.time, ctrl.t_model0, sched.v, sched.dt_model, ctrl.P, ctrl.S, qpos,
+                           qvel, sens, xpos, ix, u, v)
+            ctrl_in[:] = u
+            if k == push_tick:  # impulse = force x duration
                 d.xfrc_applied[torso_id, 0] = push[1] / (dt * control_every)
             mujoco.mj_step(m, d, nstep=control_every)
-            d.xfrc_applied[torso_id, 0] = 0.0
-            if not np.all(np.isfinite(d.qpos)) or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+            if k == push_tick:
+                d.xfrc_applied[torso_id, 0] = 0.0
+            status = kernel.record(k, d.time, qpos, sens, xpos, act, ix, v, rec, FALL_HEIGHT,
+                                   FALL_PITCH)
+            if status == 2 or bad_qacc.number:
                 unstable = f"physics became unstable at t={d.time:.3f} s"
                 break
-            forces = physics.foot_forces()
-            rec["t"].append(d.time)
-            rec["contact"].append(forces > CONTACT_FORCE_N)
-            rec["force"].append(forces)
-            rec["v"].append(ctrl.last_v)
-            rec["a"].append(np.array(d.act[:4]))
-            rec["joints"].append(physics.joint_angles())
-            h, p = physics.torso_height(), physics.torso_pitch()
-            rec["h"].append(h)
-            rec["pitch"].append(p)
-            rec["x"].append(physics.com_x())
             if record_qpos:
-                rec["qpos"].append(np.array(d.qpos))
-            body_down = False
-            for g1, g2 in d.contact.geom[:d.ncon].tolist():
-                if (g1 == floor and not_foot[g2]) or (g2 == floor and not_foot[g1]):
-                    body_down = True
-                    break
-            if fell is None and (h < FALL_HEIGHT or abs(p) > FALL_PITCH or body_down):
+                qpos_rec[k] = qpos
+            n = k + 1
+            if status == 1 and fell is None:
                 fell = float(d.time)
                 if stop_on_fall:
                     break
-    except PhysicsError as e:
+    except mujoco.FatalError as e:
         raise InputError(f"physics became unstable: {e}") from None
-    finally:
-        physics.free()
-    arr = lambda key, shape: np.array(rec[key]) if rec[key] else np.zeros(shape)  # noqa: E731
-    return Recording(arr("t", (0,)), arr("contact", (0, 2)).astype(bool), arr("force", (0, 2)),
-                     arr("v", (0, 4)), arr("a", (0, 4)), arr("joints", (0, 6)), arr("h", (0,)),
-                     arr("pitch", (0,)), arr("x", (0,)), dt * control_every, dt, fell, unstable,
-                     arr("qpos", (0, 0)))
+    r = rec[:n]
+    K = kernel
+    return Recording(r[:, K.R_T].copy(), r[:, K.R_CONTACT:K.R_CONTACT + 2] > 0.5,
+                     r[:, K.R_FORCE:K.R_FORCE + 2].copy(), r[:, K.R_V:K.R_V + 4].copy(),
+                     r[:, K.R_ACT:K.R_ACT + 4].copy(), r[:, K.R_JOINTS:K.R_JOINTS + 6].copy(),
+                     r[:, K.R_HEIGHT].copy(), r[:, K.R_PITCH].copy(), r[:, K.R_COMX].copy(),
+                     dt * control_every, dt, fell, unstable, qpos_rec[:n] if record_qpos
+                     else np.zeros((0, 0)))

@@ -6,12 +6,18 @@ Data flow per control tick (every ``control_every`` physics steps, ctrl held in 
    t_model = t_model0 + time_scale * t_s (``time_scale`` model units per second).
 2. Activation map. Cell output v -> muscle activation a = 1 / (1 + exp(-(v - v_half) / width))
    in [0, 1]; a_LF, a_RF, a_LE, a_RE drive the ankle flexor/extensor actuators directly.
-3. Pattern formation (timing from the CPG only). Alternating gaits (walk, run: the legs'
-   extensor cells in antiphase): the leg whose extensor activation is below the other's by
-   more than ``swing_margin`` has the swing command (the margin leaves both legs in stance
-   around the switch: double support). Two-legged gaits (jump, hop: extensors in phase): both legs have it while
-   the extensors are off (a_E < 0.5).
-4. Balance (SIMBICON-style, stance read from the foot contact sensors):
+3. Pattern formation (timing from the CPG only).
+   - Alternating gaits (walk, run: the legs' extensor cells in antiphase): the leg whose
+     extensor activation is below the other's by more than ``swing_margin`` has the swing
+     command (the margin leaves both legs in stance around the switch: double support).
+   - Two-legged gaits (jump, hop: extensors in phase): the extensor burst (mean a_E > 0.5) is
+     the push-off. On the ground during the burst both knees extend (PD to ``knee_stance`` plus
+     ``push``), once per burst: after lift-off a landing inside the same burst is absorbed, not
+     pushed again, so there is one jump per CPG cycle. Outside the burst the knees hold a
+     compliant crouch (``knee_crouch``, ``kp_crouch``) that absorbs the landing and loads the
+     next push; in the air they take the landing pose (``knee_swing``, ``kp_land``).
+4. Balance (stance read from the foot contact sensors).
+   Alternating gaits, SIMBICON-style:
    - contact priority: a foot on the ground stays a stance foot while the other leg is in the
      air and not commanded to stance (never swing away the only support);
    - stance hips hold the torso pitch: tau_torso = kp_t (pitch_d - pitch) - kd_t pitch_rate,
@@ -20,13 +26,23 @@ Data flow per control tick (every ``control_every`` physics steps, ctrl held in 
      theta_sw = theta0 + c_v * v_com + c_d * (x_com - x_stance_ankle) (Raibert/SIMBICON);
    - knees: stance knees straighten (plus a push torque proportional to the extensor
      activation), swing knees flex for clearance.
+   Two-legged gaits, Raibert-hopper style ("on the ground" = a foot touched the floor within
+   the last ``contact_hold`` s, which bridges contact chatter):
+   - on the ground the hips hold the torso pitch (tau_torso shared by both legs), and an
+     ankle balance reflex keeps the centre of mass over the feet: b = k_ax (x_com - x_feet)
+     + k_av v_com is added to the extensor activations when b > 0 (COM ahead: plantarflex,
+     which pushes the body back) and -b to the flexor activations when b < 0; the CPG's
+     activation is the base drive, the reflex only adds to it (both clipped to [0, 1]);
+   - in the air the hips place both feet: theta = theta0 + c_v v_com in the world, minus
+     ``kf_t`` tau_torso (the legs' swing reacts on the torso, so kf_t trades foot placement
+     for torso attitude).
 Sign conventions (see models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
 the leg forward; knee angle <= 0 (negative = flexed); ankle > 0 lifts the toes; torso pitch
 from the torso's up axis, > 0 leaning forward.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -34,7 +50,9 @@ from cpg import morris_lecar as ml
 from cpg.errors import InputError
 from cpg.integrate import simulate_ml
 
-CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
+from . import control_kernel as kernel
+
+CONTACT_N = kernel.CONTACT_N  # N: a foot carrying at least this normal force is on the ground
 
 
 @dataclass(frozen=True)
@@ -60,6 +78,18 @@ class ControlParams:
     ankle_gain: float = 1.0  # ankle muscle ctrl = ankle_gain * activation
     swing_margin: float = 0.0  # alternating gaits: swing only when a_E < a_E(other) - margin
     two_legged: bool = False  # jump/hop: both legs share stance and flight
+    # Two-legged gaits only (knee_stance/kp_knee: push-off; knee_swing: landing pose).
+    knee_crouch: float = -0.4  # knee target on the ground outside the push (rad)
+    kp_crouch: float = 1.0
+    kp_land: float = 1.0  # knee gain in the air
+    k_ax: float = 0.0  # ankle balance reflex: activation per m of COM ahead of the feet
+    k_av: float = 0.0  # ... per m/s of COM velocity
+    kf_t: float = 0.0  # in the air: hip torque from the torso pitch error (fraction)
+    contact_hold: float = 0.03  # s: ground contact held this long after the last touch
+
+
+if tuple(f.name for f in fields(ControlParams)) != kernel.PARAM_NAMES:
+    raise ImportError("ControlParams and envs.control_kernel.PARAM_NAMES disagree")
 
 
 # Presets: the paper's (I_app, phi, w_a, w_b, w_c) from Table 2 with controller settings.
@@ -72,9 +102,12 @@ GAIT_CONTROL = {
     "run": ControlParams(ankle_gain=0.582, push=0.302, theta0=0.284, c_v=0.155, c_d=0.533,
                          kp_t=5.23, kd_t=0.448, knee_swing=-1.37, time_scale=11.6, pitch_d=0.123,
                          kp_sw=2.34, kp_knee=1.49, swing_margin=-0.0386),
-    "jump": ControlParams(two_legged=True, ankle_gain=0.35, push=0.5, theta0=0.48, c_v=0.13,
-                          c_d=0.48, kp_t=1.97, kd_t=0.21, knee_swing=-0.9, time_scale=12.34,
-                          pitch_d=0.2, kp_sw=3.94, kp_knee=2.32),
+    "jump": ControlParams(two_legged=True, knee_crouch=-0.3704, kp_crouch=1.7187,
+                          knee_stance=-0.2535, push=0.2307, kp_knee=0.5514, knee_swing=-0.6535,
+                          kp_land=0.8493, theta0=0.2143, c_v=0.1755, kp_sw=1.1772, kd_sw=0.3807,
+                          kp_t=5.9007, kd_t=0.1074, pitch_d=0.2077, ankle_gain=0.0722,
+                          k_ax=28.4328, k_av=4.9962, time_scale=19.584, kf_t=-0.621,
+                          contact_hold=0.0465),
     "hop": ControlParams(two_legged=True, ankle_gain=0.37, push=0.47, theta0=0.38, c_v=0.38,
                          c_d=0.69, kp_t=3.96, kd_t=0.55, knee_swing=-1.23, time_scale=8.65,
                          pitch_d=0.11, kp_sw=1.76, kp_knee=1.42),
@@ -89,11 +122,6 @@ class CPGSchedule:
     v: np.ndarray  # (T, 4)
     dt_model: float
 
-    def at(self, t_model: float) -> np.ndarray:
-        k = min(int(t_model / self.dt_model), len(self.t_model) - 2)
-        f = t_model / self.dt_model - k
-        return (1 - f) * self.v[k] + f * self.v[k + 1]
-
 
 def cpg_schedule(i_app: float, phi: float, W: np.ndarray, y0: np.ndarray, t_model_end: float,
                  dt: float = 0.02, settle: float = 200.0) -> CPGSchedule:
@@ -101,97 +129,80 @@ def cpg_schedule(i_app: float, phi: float, W: np.ndarray, y0: np.ndarray, t_mode
     tr = simulate_ml(i_app, phi, W, y0, t_end=settle + t_model_end + 1.0, dt=dt, t_record=settle)
     if tr.diverged[0]:
         raise InputError("the CPG diverges for these weights (state left the cell's range)")
-    return CPGSchedule(tr.t - settle, tr.x[0], dt)
+    return CPGSchedule(tr.t - settle, np.ascontiguousarray(tr.x[0], dtype=float), dt)
 
 
 def activation(v: np.ndarray, p: ControlParams) -> np.ndarray:
     return 1.0 / (1.0 + np.exp(-(np.asarray(v) - p.v_half) / p.width))
 
 
-@dataclass
-class ControllerState:
-    stance: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
-    stance_x: np.ndarray = field(default_factory=lambda: np.zeros(2))  # ankle x at touchdown
+def params_array(p: ControlParams) -> np.ndarray:
+    """The parameters as the float array the compiled kernel unpacks."""
+    return np.array([float(getattr(p, n)) for n in kernel.PARAM_NAMES])
+
+
+def kernel_index(m) -> np.ndarray:
+    """Addresses in MjData that the kernel reads (layout ``kernel.IX_*``); m: mujoco.MjModel."""
+    jq = lambda n: m.jnt_qposadr[m.joint(n).id]  # noqa: E731
+    jv = lambda n: m.jnt_dofadr[m.joint(n).id]  # noqa: E731
+    sa = lambda n: m.sensor_adr[m.sensor(n).id]  # noqa: E731
+    body_floor = [sa(f"{b}_floor") for b in BODY_FLOOR_SENSORS]
+    if body_floor != list(range(body_floor[0], body_floor[0] + len(body_floor))):
+        raise InputError("the body-floor contact sensors must be consecutive in the MJCF")
+    ix = np.zeros(kernel.IX_SIZE, dtype=np.int64)
+    for i, leg in enumerate(("left", "right")):
+        ix[kernel.IX_HIP_Q + i], ix[kernel.IX_HIP_V + i] = jq(f"{leg}_hip"), jv(f"{leg}_hip")
+        ix[kernel.IX_KNEE_Q + i], ix[kernel.IX_KNEE_V + i] = jq(f"{leg}_knee"), jv(f"{leg}_knee")
+        ix[kernel.IX_FORCE + i] = sa(f"{leg}_foot_contact") + 3  # found, then force x y z: normal
+        ix[kernel.IX_FOOT + i] = m.body(f"{leg}_foot").id
+        for j, name in enumerate(("hip", "knee", "ankle")):
+            ix[kernel.IX_JOINTS + 3 * i + j] = jq(f"{leg}_{name}")
+    ix[kernel.IX_ROOTY_Q], ix[kernel.IX_ROOTY_V] = jq("rooty"), jv("rooty")
+    ix[kernel.IX_COM], ix[kernel.IX_COMVEL] = sa("com_pos"), sa("com_vel")
+    ix[kernel.IX_TORSO] = m.body("torso").id
+    ix[kernel.IX_BODY_FLOOR], ix[kernel.IX_N_BODY_FLOOR] = body_floor[0], len(body_floor)
+    return ix
+
+
+# Bodies whose touching the floor is a fall (contact sensors "<body>_floor" in biped.xml).
+BODY_FLOOR_SENSORS = ("torso", "left_thigh", "left_shank", "right_thigh", "right_shank")
 
 
 class CPGController:
-    """Maps the CPG schedule and the body state to the 8 actuator controls."""
+    """Maps the CPG schedule and the body state to the 8 actuator controls.
 
-    def __init__(self, physics, schedule: CPGSchedule, params: ControlParams,
+    A thin holder of the compiled kernel's inputs (:func:`envs.control_kernel.control`): the
+    MjData views are taken once, so a call costs one kernel dispatch. model, data: the raw
+    ``mujoco.MjModel`` / ``mujoco.MjData`` (a dm_control Physics' ``model.ptr``, ``data.ptr``).
+    """
+
+    def __init__(self, model, data, schedule: CPGSchedule, params: ControlParams,
                  t_model0: float = 0.0):
         self.p = params
         self.sched = schedule
-        self.t_model0 = t_model0
-        self.phys = physics
-        self.state = ControllerState()
+        self.t_model0 = float(t_model0)
+        self.P = params_array(params)
+        self.S = kernel.new_state()
+        self.ix = kernel_index(model)
+        d = data
+        self.views = (d.qpos, d.qvel, d.sensordata, d.xpos)
+        self.u = np.zeros(8)
         self.last_v = np.zeros(4)
 
     def t_model(self, t_s: float) -> float:
         return self.t_model0 + self.p.time_scale * t_s
 
-    def __call__(self, t_s: float) -> np.ndarray:
-        """The 8 controls at time t_s (s). Per-leg arithmetic on Python scalars: this runs
-        every control tick, where NumPy's per-call overhead would dominate."""
-        p, ph, st = self.p, self.phys, self.state
-        v = self.sched.at(self.t_model(t_s))
-        a = activation(v, p)  # LF, RF, LE, RE
-        self.last_v = v
-        aE = (float(a[2]), float(a[3]))
-        if p.two_legged:  # both legs together: extensors off
-            swing_cmd = [aE[0] < 0.5, aE[1] < 0.5]
-        else:  # alternating: the leg whose extensor is clearly the weaker one swings
-            swing_cmd = [aE[0] < aE[1] - p.swing_margin, aE[1] < aE[0] - p.swing_margin]
-        f = ph.foot_forces()
-        contact = [bool(f[0] > CONTACT_N), bool(f[1] > CONTACT_N)]
-        stance = [not swing_cmd[0], not swing_cmd[1]]
-        if p.two_legged:
-            # A leg on the ground keeps stance until push-off lifts it.
-            stance = [stance[i] or contact[i] for i in range(2)]
-            if all(swing_cmd) and any(contact):
-                stance = list(contact)
-        else:
-            for i in range(2):  # contact priority: never swing away the only support
-                if swing_cmd[i] and contact[i] and not contact[1 - i]:
-                    stance[i] = True
-            if not any(stance):  # flight in a run: keep the leg commanded to stance
-                stance = [not swing_cmd[0], not swing_cmd[1]]
-        for i in range(2):
-            if stance[i] and not st.stance[i]:
-                st.stance_x[i] = ph.ankle_x(i)
-        st.stance = np.array(stance)
+    @property
+    def stance(self) -> np.ndarray:
+        """(2,) bool: the legs the controller treats as stance legs."""
+        return self.S[kernel.S_STANCE:kernel.S_STANCE + 2] > 0.5
 
-        pitch, pitch_rate = ph.torso_pitch(), ph.torso_pitch_rate()
-        com_x, com_v = ph.com_x(), ph.com_velocity_x()
-        thigh, thigh_rate = ph.thigh_world_angles().tolist(), ph.thigh_world_rates().tolist()
-        knee, knee_rate = ph.knee_angles().tolist(), ph.knee_rates().tolist()
-        support = [stance[i] and contact[i] for i in range(2)]  # only a grounded foot holds the torso
-        n_support = support[0] + support[1]
-        ref_x = (sum(float(st.stance_x[i]) for i in range(2) if support[i]) / n_support
-                 if n_support else com_x)
-        tau_hip = [0.0, 0.0]
-        for i in range(2):
-            if not support[i]:
-                # Swing: place the foot; a stance-commanded foot in the air holds a landing pose.
-                target = (p.theta0 + p.c_v * com_v + p.c_d * (com_x - ref_x)) if not stance[i] \
-                    else p.c_v * com_v
-                tau_hip[i] = p.kp_sw * (target - thigh[i]) - p.kd_sw * thigh_rate[i]
-        # Hip torque on the thigh reacts on the torso: forward torso torque = +sum(tau_hip).
-        tau_torso = p.kp_t * (p.pitch_d - pitch) - p.kd_t * pitch_rate
-        if n_support:
-            share = (tau_torso - sum(tau_hip[i] for i in range(2) if not support[i])) / n_support
-            for i in range(2):
-                if support[i]:
-                    tau_hip[i] = share
-        u = np.empty(8)
-        u[:4] = p.ankle_gain * a
-        for i in range(2):
-            if stance[i]:
-                k = p.kp_knee * (p.knee_stance - knee[i]) - p.kd_knee * knee_rate[i] + p.push * aE[i]
-            else:
-                k = p.kp_knee * (p.knee_swing - knee[i]) - p.kd_knee * knee_rate[i]
-            u[4 + i] = min(1.0, max(-1.0, tau_hip[i]))
-            u[6 + i] = min(1.0, max(-1.0, k))
-        return u
+    def __call__(self, t_s: float) -> np.ndarray:
+        """The 8 controls at time t_s (s): LF, RF, LE, RE muscles, then hip and knee torques."""
+        qpos, qvel, sens, xpos = self.views
+        kernel.control(t_s, self.t_model0, self.sched.v, self.sched.dt_model, self.P, self.S, qpos,
+                       qvel, sens, xpos, self.ix, self.u, self.last_v)
+        return self.u
 
 
 def preset_network(gait: str):

@@ -47,7 +47,7 @@ class CPGLocomotion(base.Task):
         if self.random_cpg_state:
             y0 = ml.random_states(1, self.random)[0]
         sched = cpg_schedule(i_app, phi, W, y0, self.params.time_scale * 120.0)
-        self.controller = CPGController(physics, sched, self.params)
+        self.controller = CPGController(physics.model.ptr, physics.data.ptr, sched, self.params)
         super().initialize_episode(physics)
 
     def before_step(self, action, physics: Physics):

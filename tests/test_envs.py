@@ -36,8 +36,12 @@ def test_model_compiles_without_warnings_and_actuator_map():
     # Flexors pull only toward dorsiflexion (+), extensors only toward plantarflexion (-).
     assert m.actuator_forcerange[0, 0] == 0 and m.actuator_forcerange[0, 1] > 0
     assert m.actuator_forcerange[2, 1] == 0 and m.actuator_forcerange[2, 0] < 0
-    assert sorted(m.sensor(i).name for i in range(m.nsensor) if m.sensor_type[i] ==
-                  mujoco.mjtSensor.mjSENS_CONTACT) == ["left_foot_contact", "right_foot_contact"]
+    contact = {m.sensor(i).name for i in range(m.nsensor)
+               if m.sensor_type[i] == mujoco.mjtSensor.mjSENS_CONTACT}
+    # One stance sensor per foot, and fall sensors for every other body touching the floor.
+    assert contact == {"left_foot_contact", "right_foot_contact", "torso_floor",
+                       "left_thigh_floor", "left_shank_floor", "right_thigh_floor",
+                       "right_shank_floor"}
 
 
 def test_co_activation_stiffens_the_ankle():
@@ -78,3 +82,25 @@ def test_bad_model_and_task(tmp_path):
         envs.load("moonwalk")
     with pytest.raises(InputError, match="weights file"):
         envs.load("free")
+
+
+def test_fall_sensors_see_a_body_on_the_floor():
+    """The recorder flags a fall from the body-floor contact sensors alone (height and pitch
+    thresholds switched off): lying on the back is a fall, standing is not."""
+    from envs import control_kernel as K
+    from envs.biped import load_model
+    from envs.controller import kernel_index
+
+    m = load_model()
+    ix = kernel_index(m)
+    verdicts = []
+    for lying in (False, True):
+        d = mujoco.MjData(m)
+        if lying:  # torso on its back on the floor
+            d.qpos[m.jnt_qposadr[m.joint("rooty").id]] = 1.57
+            d.qpos[m.jnt_qposadr[m.joint("rootz").id]] = -0.8
+        mujoco.mj_forward(m, d)
+        rec = np.zeros((1, K.R_SIZE))
+        verdicts.append(K.record(0, 0.0, d.qpos, d.sensordata, d.xpos, d.act, ix, np.zeros(4), rec,
+                                 -np.inf, np.inf))
+    assert verdicts == [0, 1]

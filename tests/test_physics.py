@@ -6,8 +6,10 @@ classifier and the CPG classifier both name walk; from the Table 3 state, 10 ran
 states, and with floor friction x0.7 and x1.3.
 Run (issue criteria: no fall, lag 0.5 +- 0.1, duty < 0.5 on both feet, flight >= 10%, farther
 than walk, both classifiers agree): from the Table 3 state in full, and from at least 6 of 10
-random CPG states (the controller reaches 7-8 of 10 today; README lists what fails). Jump and
-hop are not reached yet: only that they get a verdict.
+random CPG states (the controller reaches 7-8 of 10 today; README lists what fails).
+Jump (issue criteria: no fall, the two feet's touchdowns within 0.1 stride, flight >= 10%, duty
+factor greater than hop's, both classifiers agree): from the Table 3 state, 10 random CPG states
+and friction x0.7 / x1.3; one jump per CPG cycle.
 """
 import shutil
 
@@ -63,6 +65,42 @@ def test_run_from_random_cpg_states(walk_distance):
     ok = [run_ok(validate("run", seconds=20.0, seed=k).summary(), walk_distance)
           for k in range(10, 20)]
     assert sum(ok) >= 6, ok
+
+
+def together(s) -> bool:
+    """The two feet's touchdowns within 0.1 stride of each other."""
+    lag = s["lr_phase_lag"]
+    return bool(np.isfinite(lag) and min(lag, 1.0 - lag) <= 0.1)
+
+
+def check_jump(s, hop_duty=None):
+    assert not s["fell"], s
+    assert together(s), s
+    assert s["flight"] >= 0.10, s
+    if hop_duty is not None:
+        assert min(s["duty_factor"].values()) > hop_duty, s
+    assert s["physical_gait"] == "jump" and s["cpg_gait"] == "jump", s
+
+
+@pytest.mark.parametrize("seed", [None] + list(range(10, 20)))
+def test_jump_from_cpg_states(seed):
+    check_jump(validate("jump", seconds=20.0, seed=seed).summary())
+
+
+@pytest.mark.parametrize("friction", [0.7, 1.3])
+def test_jump_with_scaled_friction(friction):
+    check_jump(validate("jump", seconds=20.0, friction_scale=friction).summary())
+
+
+def test_one_jump_per_cpg_cycle():
+    """The jump's stride is the CPG's period / time scale: the rhythm is the network's, not a
+    bounce of the body (two jumps per cycle, or a period set by the legs, would fail)."""
+    from cpg.reproduce import run_preset
+
+    v = validate("jump", seconds=20.0)
+    expected = run_preset("jump").rhythm.period / GAIT_CONTROL["jump"].time_scale
+    assert v.metrics.stride_period_s == pytest.approx(expected, rel=0.03)
+    assert len(v.metrics.touchdowns["left"]) == pytest.approx(20.0 / expected, abs=2)
 
 
 @pytest.fixture(scope="module")
