@@ -31,8 +31,8 @@ PARAM_NAMES = (
 IX_SIZE = 25
 
 # Controller state layout.
-S_STANCE, S_STANCE_X, S_LAST_GROUND, S_WAS_GROUND, S_PUSHED = 0, 2, 4, 5, 6
-S_SIZE = 7
+S_STANCE, S_STANCE_X, S_LAST_GROUND, S_WAS_GROUND, S_PUSHED, S_X0 = 0, 2, 4, 5, 6, 7
+S_SIZE = 8
 
 # Recording columns, one row per control tick.
 R_T, R_CONTACT, R_FORCE, R_V, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX = 0, 1, 3, 5, 9, 13, 19, 20, 21
@@ -47,6 +47,7 @@ def new_state() -> np.ndarray:
     s[S_STANCE:S_STANCE + 2] = 1.0
     s[S_LAST_GROUND] = -1.0
     s[S_WAS_GROUND] = 1.0
+    s[S_X0] = np.nan  # two-legged gaits: COM x at the first tick (hop in place around it)
     return s
 
 
@@ -99,6 +100,8 @@ def control(t_s, t_model0, sched_v, dt_model, P, S, qpos, qvel, sens, xpos, ix, 
         u[c] = ankle_gain * a[c]
 
     if two_legged > 0.5:
+        if math.isnan(S[S_X0]):
+            S[S_X0] = com_x
         burst = (a[2] + a[3]) / 2 > 0.5  # the extensor burst: push-off
         if contact[0] or contact[1]:
             S[S_LAST_GROUND] = t_s
@@ -118,7 +121,7 @@ def control(t_s, t_model0, sched_v, dt_model, P, S, qpos, qvel, sens, xpos, ix, 
             else:
                 u[0] = min(u[0] - b, 1.0)
                 u[1] = min(u[1] - b, 1.0)
-        theta = theta0 + c_v * com_v
+        theta = theta0 + c_v * com_v + c_d * (com_x - S[S_X0])
         for i in range(2):
             if ground:
                 hip = tau_torso / 2

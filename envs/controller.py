@@ -33,7 +33,8 @@ Data flow per control tick (every ``control_every`` physics steps, ctrl held in 
      + k_av v_com is added to the extensor activations when b > 0 (COM ahead: plantarflex,
      which pushes the body back) and -b to the flexor activations when b < 0; the CPG's
      activation is the base drive, the reflex only adds to it (both clipped to [0, 1]);
-   - in the air the hips place both feet: theta = theta0 + c_v v_com in the world, minus
+   - in the air the hips place both feet: theta = theta0 + c_v v_com + c_d (x_com - x_com(0))
+     in the world (Raibert foot placement; the c_d term holds the hop in place), minus
      ``kf_t`` tau_torso (the legs' swing reacts on the torso, so kf_t trades foot placement
      for torso attitude).
 Sign conventions (see models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
@@ -107,10 +108,13 @@ GAIT_CONTROL = {
                           kp_land=0.8493, theta0=0.2143, c_v=0.1755, kp_sw=1.1772, kd_sw=0.3807,
                           kp_t=5.9007, kd_t=0.1074, pitch_d=0.2077, ankle_gain=0.0722,
                           k_ax=28.4328, k_av=4.9962, time_scale=19.584, kf_t=-0.621,
-                          contact_hold=0.0465),
-    "hop": ControlParams(two_legged=True, ankle_gain=0.37, push=0.47, theta0=0.38, c_v=0.38,
-                         c_d=0.69, kp_t=3.96, kd_t=0.55, knee_swing=-1.23, time_scale=8.65,
-                         pitch_d=0.11, kp_sw=1.76, kp_knee=1.42),
+                          contact_hold=0.0465, c_d=0.0),
+    "hop": ControlParams(two_legged=True, knee_crouch=-0.4997, kp_crouch=1.468,
+                         knee_stance=-0.08118, push=0.874, kp_knee=3.808, knee_swing=-0.4114,
+                         kp_land=3.711, theta0=0.1107, c_v=0.09242, c_d=0.0242, kp_sw=1.463,
+                         kd_sw=0.3824, kp_t=3.923, kd_t=0.319, pitch_d=0.2249, ankle_gain=0.02124,
+                         k_ax=5.576, k_av=1.897, time_scale=19.41, kf_t=0.1534,
+                         contact_hold=0.05336),
 }
 
 

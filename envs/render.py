@@ -62,6 +62,13 @@ def check_video_size(width: int, height: int, fps: float, seconds: float) -> Non
         raise InputError(f"seconds must be positive, got {seconds}")
 
 
+_MARKER_OFFSET = np.array([0.05, -0.06, -0.05])  # m: beside the foot, toward the camera
+_MARKER_SIZE = np.array([0.05, 0.005, 0.02])  # box half-sizes (m)
+_EYE = np.eye(3).ravel()
+_STANCE_RGBA = np.array([0.1, 0.9, 0.2, 1.0], dtype=np.float32)
+_AIR_RGBA = np.array([0.6, 0.6, 0.6, 0.8], dtype=np.float32)
+
+
 class FrameRenderer:
     """Renders qpos states of the biped scene with a side camera tracking the torso."""
 
@@ -97,17 +104,15 @@ class FrameRenderer:
             for flag in (mj.mjtRndFlag.mjRND_SHADOW, mj.mjtRndFlag.mjRND_REFLECTION,
                          mj.mjtRndFlag.mjRND_SKYBOX):
                 scn.flags[flag] = 0
-        if stance is not None:
+        if stance is not None:  # a flat box under each foot: green in stance, grey in the air
             for leg, body in enumerate(self.foot_ids):
                 if scn.ngeom >= scn.maxgeom:
                     break
-                pos = self.data.xpos[body] + np.array([0.0, 0.0, -0.05])
-                rgba = [0.1, 0.9, 0.2, 1] if stance[leg] else [0.6, 0.6, 0.6, 0.8]
-                mj.mjv_initGeom(scn.geoms[scn.ngeom], mj.mjtGeom.mjGEOM_SPHERE,
-                                np.array([0.035, 0, 0]), pos, np.eye(3).ravel(),
-                                np.array(rgba, dtype=np.float32))
+                pos = self.data.xpos[body] + _MARKER_OFFSET
+                mj.mjv_initGeom(scn.geoms[scn.ngeom], mj.mjtGeom.mjGEOM_BOX, _MARKER_SIZE, pos,
+                                _EYE, _STANCE_RGBA if stance[leg] else _AIR_RGBA)
                 scn.ngeom += 1
-        return self.renderer.render().copy()
+        return self.renderer.render()  # a new array each call
 
     def close(self):
         self.renderer.close()

@@ -18,11 +18,26 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-SPACE = dict(ankle_gain=(0.03, 1.0), push=(0.0, 1.0), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
-             c_d=(0.0, 0.8), kp_t=(1.0, 6.0), kd_t=(0.1, 0.8), knee_swing=(-1.4, -0.3),
-             time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0),
-             swing_margin=(-0.4, 0.9), knee_stance=(-0.9, -0.02))
-KEYS = list(SPACE)
+# Search ranges of the gains, for the alternating (walk, run) and two-legged (jump, hop) patterns.
+SPACES = {
+    "alternating": dict(
+        ankle_gain=(0.03, 1.0), push=(0.0, 1.0), theta0=(0.05, 0.6), c_v=(0.0, 0.4),
+        c_d=(0.0, 0.8), kp_t=(1.0, 6.0), kd_t=(0.1, 0.8), knee_swing=(-1.4, -0.3),
+        time_scale=(7.0, 16.0), pitch_d=(-0.05, 0.2), kp_sw=(0.5, 4.0), kp_knee=(0.5, 4.0),
+        swing_margin=(-0.4, 0.9), knee_stance=(-0.9, -0.02)),
+    "two_legged": dict(
+        knee_crouch=(-1.0, -0.1), kp_crouch=(0.3, 4.0), knee_stance=(-0.3, 0.0), push=(0.0, 1.0),
+        kp_knee=(0.5, 5.0), knee_swing=(-0.8, -0.05), kp_land=(0.3, 4.0), theta0=(-0.2, 0.3),
+        c_v=(0.0, 0.5), c_d=(0.0, 1.0), kp_sw=(0.1, 3.0), kd_sw=(0.02, 0.4), kp_t=(0.5, 6.0), kd_t=(0.05, 0.8),
+        pitch_d=(-0.1, 0.3), ankle_gain=(0.0, 1.0), k_ax=(0.0, 40.0), k_av=(0.0, 10.0),
+        time_scale=(6.0, 30.0), kf_t=(-1.0, 1.0), contact_hold=(0.0, 0.06)),
+}
+
+
+def space(gait: str) -> dict:
+    from envs.controller import GAIT_CONTROL
+
+    return SPACES["two_legged" if GAIT_CONTROL[gait].two_legged else "alternating"]
 
 
 @functools.cache
@@ -76,13 +91,14 @@ def parse_conditions(text: str) -> list[dict]:
 def evaluate(args):
     """Mean cost over the conditions (each a rollout of ``seconds``)."""
     gait, x, seconds, conditions = args
+    keys = list(space(gait))
     from envs.biped import rollout
     from dataclasses import replace
 
     from envs.controller import GAIT_CONTROL, preset_network
     from envs.gait_metrics import measure
 
-    p = replace(GAIT_CONTROL[gait], **dict(zip(KEYS, map(float, x))))
+    p = replace(GAIT_CONTROL[gait], **dict(zip(keys, map(float, x))))
     costs = []
     for kw in conditions:
         r = rollout(preset_network(gait), p, seconds, **kw)
@@ -108,13 +124,15 @@ def main(argv=None):
                     help="seed the first population with the gait's current preset")
     a = ap.parse_args(argv)
     conds = parse_conditions(a.conditions)
-    lo = np.array([SPACE[k][0] for k in KEYS])
-    hi = np.array([SPACE[k][1] for k in KEYS])
+    sp = space(a.gait)
+    keys = list(sp)
+    lo = np.array([sp[k][0] for k in keys])
+    hi = np.array([sp[k][1] for k in keys])
     pool = ProcessPoolExecutor(2)
 
     class Tune(Problem):
         def __init__(self):
-            super().__init__(n_var=len(KEYS), n_obj=1, xl=lo, xu=hi)
+            super().__init__(n_var=len(keys), n_obj=1, xl=lo, xu=hi)
 
         def _evaluate(self, X, out, *args, **kw):
             out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds, conds)
@@ -124,14 +142,14 @@ def main(argv=None):
     if a.start:  # the current preset plus random points around it
         from envs.controller import GAIT_CONTROL
 
-        x0 = np.array([getattr(GAIT_CONTROL[a.gait], k) for k in KEYS])
+        x0 = np.array([getattr(GAIT_CONTROL[a.gait], k) for k in keys])
         rng = np.random.default_rng(a.seed)
-        sampling = np.clip(x0 + 0.1 * (hi - lo) * rng.standard_normal((a.pop, len(KEYS))), lo, hi)
+        sampling = np.clip(x0 + 0.1 * (hi - lo) * rng.standard_normal((a.pop, len(keys))), lo, hi)
         sampling[0] = np.clip(x0, lo, hi)
     algo = GA(pop_size=a.pop) if sampling is None else GA(pop_size=a.pop, sampling=sampling)
     res = minimize(Tune(), algo, ("n_gen", a.gens), seed=a.seed, verbose=True)
     print("best cost", float(res.F[0]))
-    print("ControlParams(" + ", ".join(f"{k}={v:.3g}" for k, v in zip(KEYS, res.X)) + ")")
+    print("ControlParams(" + ", ".join(f"{k}={v:.4g}" for k, v in zip(keys, res.X)) + ")")
 
 
 if __name__ == "__main__":

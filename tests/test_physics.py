@@ -10,6 +10,8 @@ random CPG states (the controller reaches 7-8 of 10 today; README lists what fai
 Jump (issue criteria: no fall, the two feet's touchdowns within 0.1 stride, flight >= 10%, duty
 factor greater than hop's, both classifiers agree): from the Table 3 state, 10 random CPG states
 and friction x0.7 / x1.3; one jump per CPG cycle.
+Hop (issue criteria: no fall, feet together within 0.1 stride, flight >= 15%, duty factor less
+than jump's, both classifiers agree): the same 13 conditions; one hop per CPG cycle.
 """
 import shutil
 
@@ -73,32 +75,50 @@ def together(s) -> bool:
     return bool(np.isfinite(lag) and min(lag, 1.0 - lag) <= 0.1)
 
 
-def check_jump(s, hop_duty=None):
+def mean_duty(s) -> float:
+    return float(np.mean(list(s["duty_factor"].values())))
+
+
+CONDITIONS = [dict(seed=None)] + [dict(seed=k) for k in range(10, 20)] + \
+    [dict(friction_scale=0.7), dict(friction_scale=1.3)]
+CONDITION_IDS = ["table3"] + [f"seed{k}" for k in range(10, 20)] + ["friction0.7", "friction1.3"]
+
+
+@pytest.fixture(scope="module")
+def table3_duty():
+    """Mean duty factor of jump and hop from the Table 3 state (each criterion compares them)."""
+    return {g: mean_duty(validate(g, seconds=20.0).summary()) for g in ("jump", "hop")}
+
+
+def check_two_legged(s, gait, min_flight, table3_duty):
     assert not s["fell"], s
     assert together(s), s
-    assert s["flight"] >= 0.10, s
-    if hop_duty is not None:
-        assert min(s["duty_factor"].values()) > hop_duty, s
-    assert s["physical_gait"] == "jump" and s["cpg_gait"] == "jump", s
+    assert s["flight"] >= min_flight, s
+    if gait == "jump":
+        assert mean_duty(s) > table3_duty["hop"], (s, table3_duty)
+    else:
+        assert mean_duty(s) < table3_duty["jump"], (s, table3_duty)
+    assert s["physical_gait"] == gait and s["cpg_gait"] == gait, s
 
 
-@pytest.mark.parametrize("seed", [None] + list(range(10, 20)))
-def test_jump_from_cpg_states(seed):
-    check_jump(validate("jump", seconds=20.0, seed=seed).summary())
+@pytest.mark.parametrize("cond", CONDITIONS, ids=CONDITION_IDS)
+def test_jump(cond, table3_duty):
+    check_two_legged(validate("jump", seconds=20.0, **cond).summary(), "jump", 0.10, table3_duty)
 
 
-@pytest.mark.parametrize("friction", [0.7, 1.3])
-def test_jump_with_scaled_friction(friction):
-    check_jump(validate("jump", seconds=20.0, friction_scale=friction).summary())
+@pytest.mark.parametrize("cond", CONDITIONS, ids=CONDITION_IDS)
+def test_hop(cond, table3_duty):
+    check_two_legged(validate("hop", seconds=20.0, **cond).summary(), "hop", 0.15, table3_duty)
 
 
-def test_one_jump_per_cpg_cycle():
-    """The jump's stride is the CPG's period / time scale: the rhythm is the network's, not a
-    bounce of the body (two jumps per cycle, or a period set by the legs, would fail)."""
+@pytest.mark.parametrize("gait", ["jump", "hop"])
+def test_one_take_off_per_cpg_cycle(gait):
+    """The stride is the CPG's period / time scale: the rhythm is the network's, not a bounce
+    of the body (two take-offs per cycle, or a period set by the legs, would fail)."""
     from cpg.reproduce import run_preset
 
-    v = validate("jump", seconds=20.0)
-    expected = run_preset("jump").rhythm.period / GAIT_CONTROL["jump"].time_scale
+    v = validate(gait, seconds=20.0)
+    expected = run_preset(gait).rhythm.period / GAIT_CONTROL[gait].time_scale
     assert v.metrics.stride_period_s == pytest.approx(expected, rel=0.03)
     assert len(v.metrics.touchdowns["left"]) == pytest.approx(20.0 / expected, abs=2)
 
