@@ -95,14 +95,15 @@ if tuple(f.name for f in fields(ControlParams)) != kernel.PARAM_NAMES:
 
 # Presets: the paper's (I_app, phi, w_a, w_b, w_c) from Table 2 with controller settings.
 GAIT_CONTROL = {
-    # Tuned with scripts/tune_controller.py (pymoo GA, fitness from the acceptance criteria);
-    # provisional where the criteria are not met yet: see README "Status of the physical gaits".
+    # Tuned with scripts/tune_controller.py (pymoo GA, fitness from the acceptance criteria,
+    # averaged over several conditions: see README "Status of the physical gaits").
     "walk": ControlParams(ankle_gain=0.0726, push=0.662, theta0=0.501, c_v=0.0631, c_d=0.681,
                           kp_t=1.01, kd_t=0.762, knee_swing=-0.912, time_scale=11.7,
                           pitch_d=0.148, kp_sw=2.08, kp_knee=3.4, swing_margin=0.25),
-    "run": ControlParams(ankle_gain=0.582, push=0.302, theta0=0.284, c_v=0.155, c_d=0.533,
-                         kp_t=5.23, kd_t=0.448, knee_swing=-1.37, time_scale=11.6, pitch_d=0.123,
-                         kp_sw=2.34, kp_knee=1.49, swing_margin=-0.0386),
+    "run": ControlParams(ankle_gain=0.5424, push=0.3988, theta0=0.3178, c_v=0.1144, c_d=0.4566,
+                         kp_t=5.243, kd_t=0.3528, knee_swing=-1.358, time_scale=10.77,
+                         pitch_d=0.1264, kp_sw=2.199, kp_knee=1.485, swing_margin=-0.03961,
+                         knee_stance=-0.02038),
     "jump": ControlParams(two_legged=True, knee_crouch=-0.3704, kp_crouch=1.7187,
                           knee_stance=-0.2535, push=0.2307, kp_knee=0.5514, knee_swing=-0.6535,
                           kp_land=0.8493, theta0=0.2143, c_v=0.1755, kp_sw=1.1772, kd_sw=0.3807,
