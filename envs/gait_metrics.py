@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numba import njit
 
 MIN_PHASE_S = 0.03
 SYNC_TOL = 0.1
@@ -34,25 +35,41 @@ HOP_DUTY = 0.45
 
 
 def debounce(contact: np.ndarray, dt: float, min_phase_s: float = MIN_PHASE_S) -> np.ndarray:
-    """Merge runs (of either value) shorter than ``min_phase_s`` into their neighbours."""
+    """Merge runs (of either value) shorter than ``min_phase_s`` into their neighbours.
+
+    Greedy: the shortest interior run is flipped first, then the runs are recomputed, until no
+    interior run is short (the first and last runs may be cut by the window, so they stay).
+    """
     c = np.asarray(contact, dtype=bool).copy()
     n_min = max(1, int(round(min_phase_s / dt)))
-    if len(c) < 2:
-        return c
-    changed = True
-    while changed:
-        changed = False
-        edges = np.flatnonzero(np.diff(c.astype(np.int8))) + 1
-        starts = np.concatenate([[0], edges])
-        ends = np.concatenate([edges, [len(c)]])
-        lengths = ends - starts
-        # Interior runs only: the first and last runs may be cut by the window.
-        short = [k for k in range(1, len(starts) - 1) if lengths[k] < n_min]
-        if short:
-            k = min(short, key=lambda k: lengths[k])
-            c[starts[k]:ends[k]] = ~c[starts[k]]
-            changed = True
+    if len(c) >= 2:
+        _debounce_inplace(c, n_min)
     return c
+
+
+@njit(cache=True)
+def _debounce_inplace(c, n_min):
+    n = len(c)
+    starts = np.empty(n + 1, dtype=np.int64)
+    while True:
+        m = 0  # run starts, then n as the sentinel end
+        starts[m] = 0
+        m += 1
+        for i in range(1, n):
+            if c[i] != c[i - 1]:
+                starts[m] = i
+                m += 1
+        starts[m] = n
+        best, best_len = -1, n_min
+        for k in range(1, m - 1):  # interior runs only
+            length = starts[k + 1] - starts[k]
+            if length < best_len:
+                best, best_len = k, length
+        if best < 0:
+            return
+        v = not c[starts[best]]
+        for i in range(starts[best], starts[best + 1]):
+            c[i] = v
 
 
 def edges(t: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

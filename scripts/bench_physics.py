@@ -35,6 +35,16 @@ def best_of(n, f):
     return min(times), out
 
 
+def paired(n, f, g):
+    """Best times of f and g, measured alternately (f, g, f, g, ...) so that drifts in the
+    machine's speed hit both alike."""
+    tf, tg = [], []
+    for _ in range(n):
+        tf.append(best_of(1, f)[0])
+        tg.append(best_of(1, g)[0])
+    return min(tf), min(tg)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seconds", type=float, default=20.0)
@@ -43,7 +53,7 @@ def main(argv=None) -> int:
     net, p = preset_network("walk"), GAIT_CONTROL["walk"]
     rollout(net, p, 0.5)  # warm up (kernel cache, imports)
 
-    t_loop, rec = best_of(3, lambda: rollout(net, p, a.seconds))
+    rec = rollout(net, p, a.seconds)
     n_steps = int(round(rec.t[-1] / rec.physics_dt))
     m = mujoco.MjModel.from_xml_path(str(BIPED_SCENE))
 
@@ -52,7 +62,7 @@ def main(argv=None) -> int:
         for _ in range(n_steps):
             mujoco.mj_step(m, d)
 
-    t_plain, _ = best_of(3, plain)
+    t_loop, t_plain = paired(5, lambda: rollout(net, p, a.seconds), plain)
     print(f"1. physics, {n_steps} steps ({rec.t[-1]:.1f} s simulated, walk):")
     print(f"   CPG + controller in the loop : {n_steps / t_loop:10.0f} steps/s")
     print(f"   plain mj_step, zero control  : {n_steps / t_plain:10.0f} steps/s")
@@ -62,11 +72,10 @@ def main(argv=None) -> int:
 
     rec = rollout(net, p, 6.0, record_qpos=True)
     idx = np.linspace(0, len(rec.t) - 1, a.frames).astype(int)
-    with FrameRenderer(640, 480) as fr:
-        fr.frame(rec.qpos[0], rec.contact[0])
-        t_ours, _ = best_of(2, lambda: [fr.frame(rec.qpos[k], rec.contact[k]) for k in idx])
+    fr = FrameRenderer(640, 480)
+    fr.frame(rec.qpos[0], rec.contact[0])
     d = mujoco.MjData(m)
-    with mujoco.Renderer(m, 480, 640) as r:
+    with fr, mujoco.Renderer(m, 480, 640) as r:
         opt = mujoco.MjvOption()
         cam = mujoco.MjvCamera()  # the same view as the cpgbiped renderer
         cam.type = mujoco.mjtCamera.mjCAMERA_FREE
@@ -85,7 +94,8 @@ def main(argv=None) -> int:
                 r.render()
 
         bare()
-        t_bare, _ = best_of(2, bare)
+        t_ours, t_bare = paired(3, lambda: [fr.frame(rec.qpos[k], rec.contact[k]) for k in idx],
+                                bare)
     print(f"2. rendering {a.frames} frames at 640x480 (MUJOCO_GL={os.environ['MUJOCO_GL']}):")
     print(f"   cpgbiped renderer            : {a.frames / t_ours:10.1f} frames/s")
     print(f"   bare mujoco.Renderer loop    : {a.frames / t_bare:10.1f} frames/s")
@@ -103,8 +113,8 @@ def main(argv=None) -> int:
             r_, m_ = without()
             write_rrd(os.path.join(tmp, "b.rrd"), {"walk": (r_, m_)})
 
-        t_without, _ = best_of(3, without)
-        t_with, _ = best_of(3, with_rrd)
+        with_rrd()
+        t_without, t_with = paired(5, without, with_rrd)
     print(f"3. rollout of {a.seconds:g} s with and without the rerun recording:")
     print(f"   without                      : {t_without:10.2f} s")
     print(f"   with .rrd                    : {t_with:10.2f} s")
