@@ -6,13 +6,16 @@ contact or no-contact shorter than ``min_phase_s`` is merged into its neighbours
 
 Definitions (over the analysis window, after the settling period):
 - touchdown / lift-off: rising / falling edges of the debounced contact of a foot;
-- stride period: median interval between successive touchdowns of a foot (both feet pooled;
-  the median ignores the odd stumble);
+- stride period: median interval between successive touchdowns of a foot (the median ignores
+  the odd stumble), the larger of the two feet's (an extra touchdown of a stuttering foot
+  shortens only that foot's intervals);
 - duty factor of a foot: fraction of the time in contact;
 - left-right lag: for each left touchdown, (next right touchdown - it) / stride period,
   circular mean as a fraction of a stride in [0, 1); 0.5 = alternating, 0 = together;
 - double support / flight: fraction of the time with both / neither foot in contact;
-- distance, mean speed: centre-of-mass x travelled and divided by the window length.
+- distance, mean speed: centre-of-mass x travelled and divided by the window length;
+- footfalls per stride of a foot: its touchdowns x stride period / window length (1 when every
+  stride has one touchdown of that foot).
 Physical gait (from these numbers alone):
 - "none" when fallen, or fewer than 3 touchdowns per foot;
 - two-legged (|lag| within ``SYNC_TOL`` of 0 or 1) with flight >= 10%: "hop" when the mean
@@ -92,6 +95,9 @@ class GaitMetrics:
     touchdowns: dict
     liftoffs: dict
     physical_gait: str
+    # Touchdowns of each foot per stride period over the window: 1 for a regular gait; more
+    # when a foot stutters (extra touchdowns), fewer when it skips strides.
+    footfalls_per_stride: dict = None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -140,7 +146,8 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
     if len(t) < 2:
         return GaitMetrics(fell_at is not None, fell_at, {"left": float("nan"), "right": float("nan")},
                            float("nan"), float("nan"), float("nan"), float("nan"), 0.0, 0.0,
-                           {"left": [], "right": []}, {"left": [], "right": []}, "none")
+                           {"left": [], "right": []}, {"left": [], "right": []}, "none",
+                           {"left": float("nan"), "right": float("nan")})
     dt = float(np.median(np.diff(t)))
     sel = t >= settle_s
     ts = t[sel]
@@ -148,8 +155,8 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
     td, lo = {}, {}
     for i, leg in enumerate(("left", "right")):
         td[leg], lo[leg] = edges(ts, cs[:, i]) if len(ts) > 1 else (np.empty(0), np.empty(0))
-    strides = np.concatenate([np.diff(td["left"]), np.diff(td["right"])])
-    period = float(np.median(strides)) if len(strides) else float("nan")
+    medians = [float(np.median(np.diff(v))) for v in td.values() if len(v) > 1]
+    period = max(medians) if medians else float("nan")
     window = float(ts[-1] - ts[0]) if len(ts) > 1 else 0.0
     distance = float(com_x[sel][-1] - com_x[sel][0]) if sel.sum() > 1 else 0.0
     m = GaitMetrics(
@@ -162,6 +169,8 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
         stride_period_s=period, distance_m=distance,
         speed_mps=distance / window if window > 0 else 0.0,
         touchdowns={k: v.tolist() for k, v in td.items()},
-        liftoffs={k: v.tolist() for k, v in lo.items()}, physical_gait="none")
+        liftoffs={k: v.tolist() for k, v in lo.items()}, physical_gait="none",
+        footfalls_per_stride={k: len(v) * period / window if window > 0 and np.isfinite(period)
+                              else float("nan") for k, v in td.items()})
     m.physical_gait = classify_physical(m)
     return m

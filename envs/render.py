@@ -173,18 +173,26 @@ def render_video(rec, path: str | Path, fps: float = 30.0, width: int = 640, hei
     return Path(path)
 
 
-def gait_diagram(rec, path: str | Path, metrics=None, title: str = "") -> Path:
-    """Footfall bars per foot over time (the locomotion literature's gait diagram), PNG."""
+def gait_diagram(rec, path: str | Path, metrics=None, title: str = "",
+                 window_s: float | None = 6.0) -> Path:
+    """Footfall bars per foot over time (the locomotion literature's gait diagram), PNG.
+
+    Shows the last ``window_s`` seconds (None: the whole rollout), so single strides stay
+    readable; the bars are the debounced contacts the metrics are computed from."""
     from cpg.plots import _plt
+
+    from .gait_metrics import debounce
 
     plt = _plt()
     fig, ax = plt.subplots(figsize=(9, 1.9))
     for row, (leg, color) in enumerate((("left", "tab:blue"), ("right", "tab:red"))):
-        c = rec.contact[:, row]
+        c = debounce(rec.contact[:, row], rec.dt)  # the contact series the metrics use
         edges = np.flatnonzero(np.diff(np.concatenate([[0], c.astype(int), [0]])))
-        for s, e in zip(edges[::2], edges[1::2]):
-            ax.broken_barh([(rec.t[s], rec.t[min(e, len(rec.t) - 1)] - rec.t[s])], (1 - row, 0.8),
-                           color=color)
+        bars = [(rec.t[s], rec.t[min(e, len(rec.t) - 1)] - rec.t[s])
+                for s, e in zip(edges[::2], edges[1::2])]
+        ax.broken_barh(bars, (1 - row, 0.8), facecolor=color, linewidth=0)  # no edge: exact widths
+    if window_s is not None and len(rec.t):
+        ax.set_xlim(max(float(rec.t[0]), float(rec.t[-1]) - window_s), float(rec.t[-1]))
     ax.set_yticks([1.4, 0.4], ["left", "right"])
     ax.set_xlabel("time (s)")
     sub = f" - physical: {metrics.physical_gait}" if metrics is not None else ""

@@ -36,7 +36,8 @@ class Validation:
             "duty_factor": m.duty_factor, "lr_phase_lag": m.lr_phase_lag,
             "double_support": m.double_support, "flight": m.flight,
             "stride_period_s": m.stride_period_s, "distance_m": m.distance_m,
-            "speed_mps": m.speed_mps, "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
+            "speed_mps": m.speed_mps, "footfalls_per_stride": m.footfalls_per_stride,
+            "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
             "passed": bool(not m.fell and m.physical_gait == self.gait == self.cpg_gait),
         }
 

@@ -6,7 +6,8 @@ criteria of the physical gaits (envs.gait_metrics): a fall costs 100 minus the s
 survived; otherwise the shortfalls from the gait's targets (left-right lag, duty factor,
 double support, flight, forward distance) are summed, plus the relative difference between
 the stride period and the CPG period / time scale (one stride per CPG cycle: the rhythm must
-be the CPG's, not a bounce of the body). Prints the best gains as Python.
+be the CPG's, not a bounce of the body) and the excess of footfalls per stride over 1 +- 0.08
+per foot (a regular gait). Prints the best gains as Python.
 
     python scripts/tune_controller.py walk [--pop 24] [--gens 15] [--seconds 12]
 """
@@ -70,7 +71,10 @@ def cost(gait: str, m, seconds: float, time_scale: float) -> float:
     else:
         c = 4 * sync + 4 * max(0, 0.2 - m.flight) + 4 * max(0, duty.mean() - 0.40) + \
             max(0, 0.0 - d) * 0.2
-    return float(c + rhythm + (0 if m.physical_gait == gait else 1.0))
+    # One touchdown per foot per stride (a stuttering foot is not a clean gait).
+    ff = np.array([m.footfalls_per_stride["left"], m.footfalls_per_stride["right"]])
+    regular = 4 * np.maximum(0, np.abs(np.nan_to_num(ff, nan=2.0) - 1) - 0.08).sum()
+    return float(c + rhythm + regular + (0 if m.physical_gait == gait else 1.0))
 
 
 def parse_conditions(text: str) -> list[dict]:

@@ -65,3 +65,20 @@ def test_touchdown_times_exact():
     m = gm.measure(T, c, T)
     assert np.allclose(np.diff(m.touchdowns["left"]), 1.0, atol=DT)
     assert np.allclose(np.array(m.touchdowns["left"]) % 1.0, 0.25, atol=DT)
+
+
+def test_footfalls_per_stride_counts_a_stuttering_foot():
+    """A run whose left foot touches down twice per stride (a 0.1-stride stutter in the middle
+    of its swing): the right foot has 1 footfall per stride, the left about 2. A regular gait
+    has exactly 1 per foot."""
+    period = 0.8
+    c, x = series(period, 0.35, 0.5)
+    m = gm.measure(T, c, x, settle_s=2.0)
+    assert m.footfalls_per_stride["left"] == pytest.approx(1.0, abs=0.06)
+    assert m.footfalls_per_stride["right"] == pytest.approx(1.0, abs=0.06)
+    stutter = c.copy()
+    stutter[:, 0] |= ((T - 0.6 * period) / period) % 1.0 < 0.1
+    m = gm.measure(T, stutter, x, settle_s=2.0)
+    assert m.stride_period_s == pytest.approx(period, abs=2 * DT)  # the right foot's strides
+    assert m.footfalls_per_stride["right"] == pytest.approx(1.0, abs=0.06)
+    assert m.footfalls_per_stride["left"] == pytest.approx(2.0, abs=0.12)
