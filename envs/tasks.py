@@ -24,7 +24,7 @@ from .biped import Physics, load_physics
 from .controller import GAIT_CONTROL, CPGController, ControlParams, cpg_schedule, preset_network
 
 TARGET_SPEED = {"walk": 0.5, "run": 1.5, "jump": 0.3, "hop": 0.3}
-CONTROL_TIMESTEP = 0.01  # s (5 physics steps of 2 ms)
+CONTROL_TIMESTEP = 0.004  # s: 2 physics steps of 2 ms, the control period the gains were tuned at
 DEFAULT_TIME_LIMIT = 20.0  # s
 
 
@@ -100,7 +100,10 @@ def load(name: str, weights: str | None = None, gait: str | None = None,
     else:
         raise InputError(f"unknown task {name!r}: use walk, run, jump, hop or free")
     physics = load_physics(xml_path) if xml_path else load_physics()
-    task = CPGLocomotion(gait, network, GAIT_CONTROL[gait], random=random,
+    from .validate import control_for
+
+    params = control_for(gait, data["chosen"]["weights"]) if name == "free" else GAIT_CONTROL[gait]
+    task = CPGLocomotion(gait, network, params, random=random,
                          random_cpg_state=random_cpg_state, friction_scale=friction_scale)
     return control.Environment(physics, task, time_limit=time_limit,
                                control_timestep=CONTROL_TIMESTEP)

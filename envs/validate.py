@@ -6,7 +6,7 @@ contacts alone. A gait is physically real when the two agree and the body did no
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -53,14 +53,38 @@ def network_for(gait: str, weights=None):
     return p.i_app, p.phi, ml.weight_matrix(w), p.y0
 
 
+def cpg_period(gait: str, weights=None) -> float:
+    """Period (model units) of the gait's network, Table 2 or with (w_a, w_b, w_c) instead."""
+    from cpg.analysis import analyze
+    from cpg.integrate import simulate_ml
+    from cpg.reproduce import T_END, T_SETTLE
+
+    i_app, phi, W, y0 = network_for(gait, weights)
+    tr = simulate_ml(i_app, phi, W, y0, t_end=T_END, t_record=T_SETTLE)
+    period = analyze(tr.t, tr.x[0]).period if not tr.diverged[0] else float("nan")
+    if not (np.isfinite(period) and period > 0):
+        raise InputError(f"the {gait} network with weights {weights} does not oscillate")
+    return float(period)
+
+
+def control_for(gait: str, weights=None):
+    """The gait's controller preset. With other weights the time scale is rescaled so that one
+    CPG cycle lasts as long in seconds as with the paper's weights: the gains were tuned for
+    that stride, and the network's rhythm (phases, waveforms, one stride per cycle) is kept."""
+    p = GAIT_CONTROL[gait]
+    if weights is None or np.allclose(np.asarray(weights, dtype=float), ml.preset(gait).weights):
+        return p
+    return replace(p, time_scale=p.time_scale * cpg_period(gait, weights) / cpg_period(gait))
+
+
 def validate(gait: str, weights=None, seconds: float = 20.0, seed: int | None = None,
              friction_scale: float = 1.0, push: tuple[float, float] | None = None,
              settle_s: float = SETTLE_S, record_qpos: bool = False) -> Validation:
     """Roll out ``seconds`` after ``settle_s`` of settling and measure the gait."""
     if not (np.isfinite(seconds) and seconds > 0):
         raise InputError(f"seconds must be a positive number, got {seconds}")
-    rec = rollout(network_for(gait, weights), GAIT_CONTROL[gait], seconds + settle_s, seed=seed,
-                  friction_scale=friction_scale, push=push, record_qpos=record_qpos,
+    rec = rollout(network_for(gait, weights), control_for(gait, weights), seconds + settle_s,
+                  seed=seed, friction_scale=friction_scale, push=push, record_qpos=record_qpos,
                   stop_on_fall=not record_qpos)
     fell_at = rec.fell_at if rec.unstable is None else (rec.t[-1] if len(rec.t) else 0.0)
     m = measure(rec.t, rec.contact, rec.com_x, fell_at, settle_s=settle_s)

@@ -124,3 +124,21 @@ def test_ankle_muscles_get_the_documented_map_of_the_cpg():
         v = np.array([np.interp(tm, sched.t_model, sched.v[:, c]) for c in range(4)])
         assert np.allclose(ctrl.last_v, v, atol=1e-9)
         assert np.allclose(u[:4], p.ankle_gain * activation(v, p), atol=1e-9)
+
+
+@pytest.mark.parametrize("gait", ["walk", "run", "jump", "hop"])
+def test_environment_with_zero_residual_produces_the_gait(gait):
+    """The dm_control environment steps the same CPG controller as the validated rollouts:
+    with a zero residual action the contacts it produces name its gait."""
+    from envs.gait_metrics import measure
+
+    env = envs.load(gait, random=1, time_limit=12.0)
+    ts = env.reset()
+    t, contact, x = [], [], []
+    while not ts.last():
+        ts = env.step(np.zeros(8))
+        t.append(env.physics.data.time)
+        contact.append(env.physics.foot_contacts())
+        x.append(env.physics.com_x())
+    m = measure(np.array(t), np.array(contact), np.array(x), settle_s=2.0)
+    assert not m.fell and m.physical_gait == gait, m
