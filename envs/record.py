@@ -2,15 +2,16 @@
 
 Entities, per rollout under ``/<name>`` (e.g. ``/walk``):
   contacts/left, contacts/right       debounced foot contact (0/1), the gait diagram
-  force/left, force/right             normal ground reaction force (N)
+  force                               normal ground reaction force (N), series left, right
   cpg/LF .. cpg/RE                    the four CPG cell outputs
-  activation/LF .. activation/RE      ankle muscle activations
-  joints/<leg>_<joint>                hip, knee, ankle angles (rad)
+  activation                          ankle muscle activations, series LF, RF, LE, RE
+  joints                              hip, knee, ankle angles (rad), series <leg>_<joint>
   torso/height, torso/pitch           m, rad
   events/<leg>/touchdown|liftoff      1.0 at each event time
   metrics                             the gait metrics as a Markdown document (static)
   video                               the rendered video as an asset (optional)
-Everything is logged with ``send_columns`` (one call per series, not per step). The default
+Everything is logged with ``send_columns`` (one call per entity, not per step; an entity with
+several series carries one scalar per series in each row, named by a static SeriesLines). The default
 blueprint shows, per rollout, the contacts above the CPG signals. Written to a temporary file
 and renamed.
 """
@@ -41,10 +42,13 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
     import rerun as rr
 
     t = rec.t
+    for path, names, x in (("force", ("left", "right"), rec.force),
+                           ("activation", CELLS, rec.activation), ("joints", JOINTS, rec.joints)):
+        rs.log(f"/{name}/{path}", rr.SeriesLines(names=list(names)), static=True)
+        _columns(rs, f"/{name}/{path}", t, x)
     for i, leg in enumerate(("left", "right")):
         c = debounce(rec.contact[:, i], rec.dt)
         _columns(rs, f"/{name}/contacts/{leg}", t, c.astype(float))
-        _columns(rs, f"/{name}/force/{leg}", t, rec.force[:, i])
         td, lo = edges(t, c)
         if len(td):
             _columns(rs, f"/{name}/events/{leg}/touchdown", td, np.ones(len(td)))
@@ -52,9 +56,6 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
             _columns(rs, f"/{name}/events/{leg}/liftoff", lo, np.ones(len(lo)))
     for k, cell in enumerate(CELLS):
         _columns(rs, f"/{name}/cpg/{cell}", t, rec.cpg_v[:, k])
-        _columns(rs, f"/{name}/activation/{cell}", t, rec.activation[:, k])
-    for j, joint in enumerate(JOINTS):
-        _columns(rs, f"/{name}/joints/{joint}", t, rec.joints[:, j])
     _columns(rs, f"/{name}/torso/height", t, rec.torso_height)
     _columns(rs, f"/{name}/torso/pitch", t, rec.torso_pitch)
     if metrics is not None:
@@ -97,7 +98,8 @@ def write_rrd(path: str | Path, rollouts: dict, videos: dict | None = None) -> P
 
 
 def read_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Scalar series of an .rrd: entity path -> (sim_time in s, values), via rerun's reader."""
+    """Scalar series of an .rrd: entity path -> (sim_time in s, values (T,) or (T, k) for an
+    entity with k series), via rerun's reader."""
     from rerun.chunk import RrdReader
 
     out: dict[str, list] = {}
@@ -108,7 +110,8 @@ def read_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
             continue
         col = batch.column("sim_time")
         t = np.asarray(col.cast("int64").to_numpy(zero_copy_only=False), dtype=float) * 1e-9
-        v = np.array([s[0] for s in batch.column("Scalars:scalars").to_pylist()], dtype=float)
+        v = np.array(batch.column("Scalars:scalars").to_pylist(), dtype=float)
+        v = v[:, 0] if v.ndim == 2 and v.shape[1] == 1 else v
         out.setdefault(str(chunk.entity_path), []).append((t, v))
     res = {}
     for k, parts in out.items():

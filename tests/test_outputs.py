@@ -80,6 +80,9 @@ def test_rrd_contacts_match_validate(tmp_path):
         assert len(t) > 100 and np.ptp(v) > 0.1
     v = validate("walk", seconds=8.0)  # the same deterministic rollout
     dt_phys = v.recording.physics_dt
+    t, joints = series["/walk/joints"]  # one entity, six series per row
+    assert joints.shape == v.recording.joints.shape
+    assert np.allclose(joints, v.recording.joints)
     for leg in ("left", "right"):
         t, c = series[f"/walk/contacts/{leg}"]
         td_logged = edges(t, c > 0.5)[0]
