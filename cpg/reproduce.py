@@ -34,10 +34,12 @@ class GaitResult:
 
 
 def run_preset(gait: str, y0: np.ndarray | None = None, t_end: float = T_END,
-               t_settle: float = T_SETTLE, dt: float = DT_ML) -> GaitResult:
-    """Simulate a Table 2 preset (from Table 3's state unless y0 is given) and classify it."""
+               t_settle: float = T_SETTLE, dt: float = DT_ML, weights=None) -> GaitResult:
+    """Simulate a Table 2 preset (from Table 3's state unless y0 is given; with
+    (w_a, w_b, w_c) = ``weights`` instead of Table 2's when given) and classify it."""
     p = ml.preset(gait)
-    tr = simulate_ml(p.i_app, p.phi, ml.weight_matrix(p.weights), p.y0 if y0 is None else y0,
+    w = np.asarray(p.weights if weights is None else weights, dtype=float)
+    tr = simulate_ml(p.i_app, p.phi, ml.weight_matrix(w), p.y0 if y0 is None else y0,
                      t_end=t_end, dt=dt, t_record=t_settle)
     name, rhythm = classify(tr.t, tr.x[0])
     return GaitResult(gait, tr, rhythm, name)

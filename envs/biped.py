@@ -18,98 +18,55 @@ from cpg.errors import InputError
 from models import BIPED_SCENE
 
 from . import control_kernel as kernel
-from .controller import CONTACT_N, CPGController, ControlParams, cpg_schedule
+from .controller import CPGController, ControlParams, cpg_schedule, kernel_index
 
 FALL_HEIGHT = 0.55  # torso (hip) height below which the biped has fallen (m); standing 0.86
 FALL_PITCH = 1.0  # |torso pitch| above which it has fallen (rad)
-# Any geom other than a foot touching the floor (a knee, a shank, the torso) is a fall too.
-CONTACT_FORCE_N = CONTACT_N  # raw contact: at least this normal force (N) on the foot
+# Any body other than a foot touching the floor (a knee, a shank, the torso) is a fall too.
 
 
 class Physics(_Physics):
     """Named accessors for the biped (legs indexed 0 = left, 1 = right).
 
-    Addresses are looked up once (``_index``); the accessors are plain array reads, cheap
-    enough for the control loop.
+    Addresses come from the controller's table (:func:`envs.controller.kernel_index`), looked
+    up once; the accessors are plain reads of the raw MjData.
     """
 
     def _index(self):
         if getattr(self, "_ix", None) is None:
-            m = self.model.ptr
-            jq = lambda n: m.jnt_qposadr[m.joint(n).id]  # noqa: E731
-            jv = lambda n: m.jnt_dofadr[m.joint(n).id]  # noqa: E731
-            sa = lambda n: m.sensor_adr[m.sensor(n).id]  # noqa: E731
-            joints = [f"{leg}_{j}" for leg in ("left", "right") for j in ("hip", "knee", "ankle")]
-            self._ix = dict(
-                rooty_q=jq("rooty"), rooty_v=jv("rooty"),
-                joints_q=np.array([jq(n) for n in joints]),
-                hips_q=np.array([jq("left_hip"), jq("right_hip")]),
-                hips_v=np.array([jv("left_hip"), jv("right_hip")]),
-                knees_q=np.array([jq("left_knee"), jq("right_knee")]),
-                knees_v=np.array([jv("left_knee"), jv("right_knee")]),
-                force=np.array([sa("left_foot_contact") + 3, sa("right_foot_contact") + 3]),
-                com=sa("com_pos"), comvel=sa("com_vel"),
-                torso=m.body("torso").id,
-                feet=np.array([m.body("left_foot").id, m.body("right_foot").id]),
-                d=self.data.ptr,  # raw MjData: no wrapper overhead in the control loop
-            )
-        return self._ix
+            self._ix = kernel_index(self.model.ptr)
+        return self._ix, self.data.ptr
 
     def foot_forces(self) -> np.ndarray:
         """Normal ground reaction force on each foot (N), from the contact sensors."""
-        ix = self._index()
-        return np.abs(ix["d"].sensordata[ix["force"]])
+        ix, d = self._index()
+        return np.abs(d.sensordata[ix[kernel.IX_FORCE:kernel.IX_FORCE + 2]])
 
     def foot_contacts(self) -> np.ndarray:
         """Raw (not debounced) foot contact with the floor, (2,) bool."""
-        return self.foot_forces() > CONTACT_FORCE_N
+        return self.foot_forces() > kernel.CONTACT_N
 
     def torso_height(self) -> float:
-        ix = self._index()
-        return float(ix["d"].xpos[ix["torso"], 2])
+        ix, d = self._index()
+        return float(d.xpos[ix[kernel.IX_TORSO], 2])
 
     def torso_pitch(self) -> float:
         """Forward lean of the torso (rad); the root hinge turns about 0 -1 0."""
-        ix = self._index()
-        return -float(ix["d"].qpos[ix["rooty_q"]])
-
-    def torso_pitch_rate(self) -> float:
-        ix = self._index()
-        return -float(ix["d"].qvel[ix["rooty_v"]])
+        ix, d = self._index()
+        return -float(d.qpos[ix[kernel.IX_ROOTY_Q]])
 
     def com_x(self) -> float:
-        ix = self._index()
-        return float(ix["d"].sensordata[ix["com"]])
+        ix, d = self._index()
+        return float(d.sensordata[ix[kernel.IX_COM]])
 
     def com_velocity_x(self) -> float:
-        ix = self._index()
-        return float(ix["d"].sensordata[ix["comvel"]])
+        ix, d = self._index()
+        return float(d.sensordata[ix[kernel.IX_COMVEL]])
 
     def joint_angles(self) -> np.ndarray:
         """(6,) rad: left hip, knee, ankle, right hip, knee, ankle."""
-        ix = self._index()
-        return ix["d"].qpos[ix["joints_q"]]
-
-    def thigh_world_angles(self) -> np.ndarray:
-        """Thigh angle from the vertical in the world, > 0 forward (rad)."""
-        ix = self._index()
-        return ix["d"].qpos[ix["hips_q"]] + ix["d"].qpos[ix["rooty_q"]]
-
-    def thigh_world_rates(self) -> np.ndarray:
-        ix = self._index()
-        return ix["d"].qvel[ix["hips_v"]] + ix["d"].qvel[ix["rooty_v"]]
-
-    def knee_angles(self) -> np.ndarray:
-        ix = self._index()
-        return ix["d"].qpos[ix["knees_q"]]
-
-    def knee_rates(self) -> np.ndarray:
-        ix = self._index()
-        return ix["d"].qvel[ix["knees_v"]]
-
-    def ankle_x(self, leg: int) -> float:
-        ix = self._index()
-        return float(ix["d"].xpos[ix["feet"][leg], 0])
+        ix, d = self._index()
+        return d.qpos[ix[kernel.IX_JOINTS:kernel.IX_JOINTS + 6]]
 
     def scale_friction(self, factor: float) -> None:
         scale_friction(self.model.ptr, factor)
@@ -200,14 +157,12 @@ def rollout(network, params: ControlParams, seconds: float, *, seed: int | None 
         qpos_rec = np.zeros((n_ticks if record_qpos else 0, m.nq))
         fell, unstable, n = None, None, 0
         torso_id = m.body("torso").id
-        qpos, qvel, sens, xpos, act, ctrl_in = d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl
-        ix, u, v = ctrl.ix, ctrl.u, ctrl.last_v
+        qpos, sens, xpos, act, ctrl_in = d.qpos, d.sensordata, d.xpos, d.act, d.ctrl
+        ix, v = ctrl.ix, ctrl.last_v
         bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
         push_tick = None if push is None else int(round(push[0] / (dt * control_every)))
         for k in range(n_ticks):
-            kernel.control(d.time, ctrl.t_model0, sched.v, sched.dt_model, ctrl.P, ctrl.S, qpos,
-                           qvel, sens, xpos, ix, u, v)
-            ctrl_in[:] = u
+            ctrl_in[:] = ctrl(d.time)
             if k == push_tick:  # impulse = force x duration
                 d.xfrc_applied[torso_id, 0] = push[1] / (dt * control_every)
             mujoco.mj_step(m, d, nstep=control_every)

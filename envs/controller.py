@@ -53,7 +53,6 @@ from cpg.integrate import simulate_ml
 
 from . import control_kernel as kernel
 
-CONTACT_N = kernel.CONTACT_N  # N: a foot carrying at least this normal force is on the ground
 
 
 @dataclass(frozen=True)

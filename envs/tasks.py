@@ -93,17 +93,17 @@ def load(name: str, weights: str | None = None, gait: str | None = None,
         data = load_result(weights)
         gait = gait or data["gait"]
         p = ml.preset(gait)
-        network = (p.i_app, p.phi, ml.weight_matrix(np.array(data["chosen"]["weights"])), p.y0)
+        weights = data["chosen"]["weights"]
+        network = (p.i_app, p.phi, ml.weight_matrix(np.array(weights)), p.y0)
     elif name in GAIT_CONTROL:
-        gait = name
+        gait, weights = name, None
         network = preset_network(name)
     else:
         raise InputError(f"unknown task {name!r}: use walk, run, jump, hop or free")
     physics = load_physics(xml_path) if xml_path else load_physics()
     from .validate import control_for
 
-    params = control_for(gait, data["chosen"]["weights"]) if name == "free" else GAIT_CONTROL[gait]
-    task = CPGLocomotion(gait, network, params, random=random,
+    task = CPGLocomotion(gait, network, control_for(gait, weights), random=random,
                          random_cpg_state=random_cpg_state, friction_scale=friction_scale)
     return control.Environment(physics, task, time_limit=time_limit,
                                control_timestep=CONTROL_TIMESTEP)

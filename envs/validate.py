@@ -55,13 +55,11 @@ def network_for(gait: str, weights=None):
 
 def cpg_period(gait: str, weights=None) -> float:
     """Period (model units) of the gait's network, Table 2 or with (w_a, w_b, w_c) instead."""
-    from cpg.analysis import analyze
-    from cpg.integrate import simulate_ml
-    from cpg.reproduce import T_END, T_SETTLE
+    from cpg.reproduce import run_preset
 
-    i_app, phi, W, y0 = network_for(gait, weights)
-    tr = simulate_ml(i_app, phi, W, y0, t_end=T_END, t_record=T_SETTLE)
-    period = analyze(tr.t, tr.x[0]).period if not tr.diverged[0] else float("nan")
+    network_for(gait, weights)  # checks the gait and the weights' shape
+    res = run_preset(gait, weights=weights)
+    period = float("nan") if res.trajectory.diverged[0] else res.rhythm.period
     if not (np.isfinite(period) and period > 0):
         raise InputError(f"the {gait} network with weights {weights} does not oscillate")
     return float(period)

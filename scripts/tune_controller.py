@@ -43,10 +43,10 @@ def space(gait: str) -> dict:
 
 @functools.cache
 def cpg_period(gait: str) -> float:
-    """The preset's CPG period (model units), from the network alone."""
-    from cpg.reproduce import run_preset
+    """The preset's CPG period (model units), from the network alone (cached per process)."""
+    from envs.validate import cpg_period as period
 
-    return run_preset(gait).rhythm.period
+    return period(gait)
 
 
 def cost(gait: str, m, seconds: float, time_scale: float) -> float:
