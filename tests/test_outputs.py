@@ -73,19 +73,21 @@ def test_rrd_contacts_match_validate(tmp_path):
     r = cli("log", "--gait", "walk", "--seconds", "8", "--rrd", str(rrd))
     assert r.returncode == 0, r.stderr
     series = read_rrd(rrd)
-    for leg in ("left", "right"):
-        assert f"/walk/contacts/{leg}" in series
-    for cell in ("LF", "RF", "LE", "RE"):
-        t, v = series[f"/walk/cpg/{cell}"]
-        assert len(t) > 100 and np.ptp(v) > 0.1
+    t, cpg = series["/walk/cpg"]  # one entity, a series per cell LF, RF, LE, RE
+    assert cpg.shape == (len(t), 4) and len(t) > 100
+    assert np.all(np.ptp(cpg, axis=0) > 0.1)
     v = validate("walk", seconds=8.0)  # the same deterministic rollout
     dt_phys = v.recording.physics_dt
     t, joints = series["/walk/joints"]  # one entity, six series per row
     assert joints.shape == v.recording.joints.shape
     assert np.allclose(joints, v.recording.joints)
-    for leg in ("left", "right"):
-        t, c = series[f"/walk/contacts/{leg}"]
-        td_logged = edges(t, c > 0.5)[0]
+    t, contacts = series["/walk/contacts"]  # series left, right
+    assert contacts.shape == (len(t), 2)
+    for i, leg in enumerate(("left", "right")):
+        td_logged, lo_logged = edges(t, contacts[:, i] > 0.5)
+        # the event entities carry the same edges as the contact series
+        assert np.array_equal(series[f"/walk/events/{leg}/touchdown"][0], td_logged)
+        assert np.array_equal(series[f"/walk/events/{leg}/liftoff"][0], lo_logged)
         td_logged = td_logged[td_logged >= 2.0]
         td_validate = np.array(v.metrics.touchdowns[leg])
         assert len(td_logged) == len(td_validate) > 3
@@ -169,4 +171,4 @@ def test_render_rrd_holds_the_video(tmp_path):
             if "VideoFrameReference:timestamp" in batch.schema.names:
                 frames += batch.num_rows
     assert "AssetVideo:blob" in kinds and frames == 20
-    assert "/walk/cpg/LF" in read_rrd(tmp_path / "w.rrd")
+    assert "/walk/cpg" in read_rrd(tmp_path / "w.rrd")
