@@ -7,7 +7,9 @@ survived; otherwise the shortfalls from the gait's targets (left-right lag, duty
 double support, flight, forward distance) are summed, plus the relative difference between
 the stride period and the CPG period / time scale (one stride per CPG cycle: the rhythm must
 be the CPG's, not a bounce of the body) and the excess of footfalls per stride over 1 +- 0.08
-per foot (a regular gait). Prints the best gains as Python.
+per foot and the fraction of touchdown intervals shorter than 0.6 stride (a regular gait, no
+stutter). Conditions may include other weights (``weights:w_a/w_b/w_c``), with the time scale
+rescaled as validate does. Prints the best gains as Python.
 
     python scripts/tune_controller.py walk [--pop 24] [--gens 15] [--seconds 12]
 """
@@ -42,18 +44,23 @@ def space(gait: str) -> dict:
 
 
 @functools.cache
-def cpg_period(gait: str) -> float:
-    """The preset's CPG period (model units), from the network alone (cached per process)."""
+def cpg_period(gait: str, weights=None) -> float:
+    """The CPG period (model units) of the gait's network, Table 2 or other weights, from the
+    network alone (cached per process)."""
     from envs.validate import cpg_period as period
 
-    return period(gait)
+    return period(gait, weights)
 
 
-def cost(gait: str, m, seconds: float, time_scale: float) -> float:
+def period_ratio(gait: str, weights) -> float:
+    return cpg_period(gait, weights) / cpg_period(gait)
+
+
+def cost(gait: str, m, seconds: float, time_scale: float, weights=None) -> float:
     if m.fell:
         return 100.0 - (m.fell_at_s or 0.0)
     # The rhythm must be the CPG's: one stride per CPG cycle.
-    expected = cpg_period(gait) / time_scale
+    expected = cpg_period(gait, weights) / time_scale
     rhythm = 4 * abs(m.stride_period_s - expected) / expected if np.isfinite(m.stride_period_s) else 4
     duty = np.array([m.duty_factor["left"], m.duty_factor["right"]])
     lag = m.lr_phase_lag if np.isfinite(m.lr_phase_lag) else 0.25
@@ -74,11 +81,16 @@ def cost(gait: str, m, seconds: float, time_scale: float) -> float:
     # One touchdown per foot per stride (a stuttering foot is not a clean gait).
     ff = np.array([m.footfalls_per_stride["left"], m.footfalls_per_stride["right"]])
     regular = 4 * np.maximum(0, np.abs(np.nan_to_num(ff, nan=2.0) - 1) - 0.08).sum()
-    return float(c + rhythm + regular + (0 if m.physical_gait == gait else 1.0))
+    # ... and no stutter: touchdown intervals shorter than 0.6 stride are extra footfalls.
+    if np.isfinite(m.stride_period_s):
+        for td in m.touchdowns.values():
+            d = np.diff(td)
+            regular += 4 * float(np.mean(d < 0.6 * m.stride_period_s)) if len(d) else 0.0
+    return float(c + rhythm + regular + (0 if m.physical_gait == gait else 4.0))
 
 
 def parse_conditions(text: str) -> list[dict]:
-    """"table3,seed:11,friction:0.7" -> rollout keyword sets."""
+    """"table3,seed:11,friction:0.7,weights:0.1/-0.2/0.3" -> rollout keyword sets."""
     out = []
     for item in text.split(","):
         if item == "table3":
@@ -87,6 +99,8 @@ def parse_conditions(text: str) -> list[dict]:
             out.append({"seed": int(item[5:])})
         elif item.startswith("friction:"):
             out.append({"friction_scale": float(item[9:])})
+        elif item.startswith("weights:"):  # weights:w_a/w_b/w_c, e.g. an optimiser result
+            out.append({"weights": tuple(float(w) for w in item[8:].split("/"))})
         else:
             raise SystemExit(f"unknown condition {item!r}")
     return out
@@ -105,9 +119,16 @@ def evaluate(args):
     p = replace(GAIT_CONTROL[gait], **dict(zip(keys, map(float, x))))
     costs = []
     for kw in conditions:
-        r = rollout(preset_network(gait), p, seconds, **kw)
+        kw, net, q = dict(kw), preset_network(gait), p
+        w = kw.pop("weights", None)
+        if w is not None:  # as validate does: other weights keep the stride (time scale rescaled)
+            from envs.validate import network_for
+
+            net = network_for(gait, w)
+            q = replace(p, time_scale=p.time_scale * period_ratio(gait, w))
+        r = rollout(net, q, seconds, **kw)
         costs.append(cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds,
-                          p.time_scale))
+                          q.time_scale, w))
     return float(np.mean(costs))
 
 
