@@ -12,6 +12,12 @@ stutter). Conditions may include other weights (``weights:w_a/w_b/w_c``), with t
 rescaled as validate does. Prints the best gains as Python.
 
     python scripts/tune_controller.py walk [--pop 24] [--gens 15] [--seconds 12]
+
+Without ``--start`` the first population is random over the ranges below; refining a preset
+(``--start``) stays in its basin. The present run came from a random population:
+
+    python scripts/tune_controller.py run --pop 60 --gens 60 --seed 7 \
+        --conditions table3,seed:10,seed:11,friction:0.7
 """
 from __future__ import annotations
 

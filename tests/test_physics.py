@@ -5,7 +5,8 @@ factor >= 0.55 on both feet; double support > 5%; flight < 2%; >= 2 m; the conta
 classifier and the CPG classifier both name walk; from the Table 3 state, 10 random CPG
 states, and with floor friction x0.7 and x1.3.
 Run (issue criteria: no fall, lag 0.5 +- 0.1, duty < 0.5 on both feet, flight >= 10%, farther
-than walk, both classifiers agree): the same 13 conditions.
+than walk, both classifiers agree): the same 13 conditions; one touchdown per foot per CPG
+cycle (no stutter).
 Jump (issue criteria: no fall, the two feet's touchdowns within 0.1 stride, flight >= 10%, duty
 factor greater than hop's, both classifiers agree): from the Table 3 state, 10 random CPG states
 and friction x0.7 / x1.3; one jump per CPG cycle.
@@ -62,6 +63,8 @@ def walk_distance():
 def test_run(cond, walk_distance):
     s = validate("run", seconds=20.0, **cond).summary()
     assert run_ok(s, walk_distance), s
+    # one touchdown per foot per stride: no bounce into a second, short flight (stutter)
+    assert max(s["footfalls_per_stride"].values()) <= 1.08, s
 
 
 def together(s) -> bool:
@@ -101,7 +104,7 @@ def test_hop(cond, table3_duty):
     check_two_legged(validate("hop", seconds=20.0, **cond).summary(), "hop", 0.15, table3_duty)
 
 
-@pytest.mark.parametrize("gait", ["jump", "hop"])
+@pytest.mark.parametrize("gait", ["run", "jump", "hop"])
 def test_one_take_off_per_cpg_cycle(gait):
     """The stride is the CPG's period / time scale: the rhythm is the network's, not a bounce
     of the body (two take-offs per cycle, or a period set by the legs, would fail)."""
