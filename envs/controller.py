@@ -96,9 +96,13 @@ if tuple(f.name for f in fields(ControlParams)) != kernel.PARAM_NAMES:
 GAIT_CONTROL = {
     # Tuned with scripts/tune_controller.py (pymoo GA, fitness from the acceptance criteria,
     # averaged over several conditions: see README "Status of the physical gaits").
-    "walk": ControlParams(ankle_gain=0.0726, push=0.662, theta0=0.501, c_v=0.0631, c_d=0.681,
-                          kp_t=1.01, kd_t=0.762, knee_swing=-0.912, time_scale=11.7,
-                          pitch_d=0.148, kp_sw=2.08, kp_knee=3.4, swing_margin=0.25),
+    # walk: a GA from a random population (pop 60, 60 generations, seed 7, conditions table3,
+    # seed:10, seed:11, friction:0.7), then refined (--start, 30 generations) with friction
+    # x0.5 and x2.0 added; the earlier walk started at double cadence for 2-10 s.
+    "walk": ControlParams(ankle_gain=0.5053, push=0.9162, theta0=0.1523, c_v=0.2233,
+                          c_d=0.4651, kp_t=1.069, kd_t=0.4888, knee_swing=-0.9822,
+                          time_scale=15.61, pitch_d=0.185, kp_sw=1.09, kp_knee=1.007,
+                          swing_margin=0.03528, knee_stance=-0.1806),
     # run: a GA from a random population (pop 60, 60 generations, seed 7, conditions table3,
     # seed:10, seed:11, friction:0.7); the earlier run, refined from a preset, stuttered.
     "run": ControlParams(ankle_gain=0.6628, push=0.09236, theta0=0.2684, c_v=0.3231,

@@ -62,7 +62,13 @@ def period_ratio(gait: str, weights) -> float:
     return cpg_period(gait, weights) / cpg_period(gait)
 
 
-def cost(gait: str, m, seconds: float, time_scale: float, weights=None) -> float:
+# Forward speed (m/s) below which the distance term costs, per gait (--min-speed overrides).
+MIN_SPEED = {"walk": 0.25, "run": 0.35, "jump": 0.0, "hop": 0.0}
+
+
+def cost(gait: str, m, seconds: float, time_scale: float, weights=None,
+         min_speed: float | None = None) -> float:
+    v_min = MIN_SPEED[gait] if min_speed is None else min_speed
     if m.fell:
         return 100.0 - (m.fell_at_s or 0.0)
     # The rhythm must be the CPG's: one stride per CPG cycle.
@@ -74,16 +80,16 @@ def cost(gait: str, m, seconds: float, time_scale: float, weights=None) -> float
     d = m.distance_m
     if gait == "walk":
         c = 4 * abs(lag - 0.5) + 4 * np.maximum(0, 0.58 - duty).sum() + \
-            4 * max(0, 0.07 - m.double_support) + 8 * m.flight + max(0, 0.25 * seconds - d)
+            4 * max(0, 0.07 - m.double_support) + 8 * m.flight + max(0, v_min * seconds - d)
     elif gait == "run":
         c = 4 * abs(lag - 0.5) + 4 * np.maximum(0, duty - 0.45).sum() + \
-            4 * max(0, 0.14 - m.flight) + max(0, 0.35 * seconds - d)
+            4 * max(0, 0.14 - m.flight) + max(0, v_min * seconds - d)
     elif gait == "jump":
         c = 4 * sync + 4 * max(0, 0.14 - m.flight) + 4 * max(0, 0.5 - duty.mean()) + \
-            max(0, 0.0 - d) * 0.2
+            max(0, v_min * seconds - d) * 0.2
     else:
         c = 4 * sync + 4 * max(0, 0.2 - m.flight) + 4 * max(0, duty.mean() - 0.40) + \
-            max(0, 0.0 - d) * 0.2
+            max(0, v_min * seconds - d) * 0.2
     # One touchdown per foot per stride (a stuttering foot is not a clean gait).
     ff = np.array([m.footfalls_per_stride["left"], m.footfalls_per_stride["right"]])
     regular = 4 * np.maximum(0, np.abs(np.nan_to_num(ff, nan=2.0) - 1) - 0.08).sum()
@@ -114,7 +120,7 @@ def parse_conditions(text: str) -> list[dict]:
 
 def evaluate(args):
     """Mean cost over the conditions (each a rollout of ``seconds``)."""
-    gait, x, seconds, conditions = args
+    gait, x, seconds, conditions, min_speed = args
     keys = list(space(gait))
     from envs.biped import rollout
     from dataclasses import replace
@@ -134,7 +140,7 @@ def evaluate(args):
             q = replace(p, time_scale=p.time_scale * period_ratio(gait, w))
         r = rollout(net, q, seconds, **kw)
         costs.append(cost(gait, measure(r.t, r.contact, r.com_x, r.fell_at, settle_s=2.0), seconds,
-                          q.time_scale, w))
+                          q.time_scale, w, min_speed))
     return float(np.mean(costs))
 
 
@@ -151,6 +157,9 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--conditions", default="table3",
                     help="comma list of table3, seed:N, friction:F; fitness = mean cost")
+    ap.add_argument("--min-speed", type=float, default=None,
+                    help="forward speed (m/s) the distance term asks for (default per gait: "
+                         + ", ".join(f"{g} {v:g}" for g, v in MIN_SPEED.items()) + ")")
     ap.add_argument("--start", action="store_true",
                     help="seed the first population with the gait's current preset")
     a = ap.parse_args(argv)
@@ -166,7 +175,7 @@ def main(argv=None):
             super().__init__(n_var=len(keys), n_obj=1, xl=lo, xu=hi)
 
         def _evaluate(self, X, out, *args, **kw):
-            out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds, conds)
+            out["F"] = np.array(list(pool.map(evaluate, [(a.gait, x, a.seconds, conds, a.min_speed)
                                                          for x in X])))
 
     sampling = None

@@ -147,6 +147,17 @@ def test_cpg_rhythm_sets_stride_period(walk_cpg_period):
     assert v.metrics.stride_period_s == pytest.approx(expected, rel=0.03)
 
 
+def test_walk_steps_once_per_cpg_cycle_from_the_start(walk_cpg_period):
+    """Every touchdown interval after the 2 s settling is one stride (CPG period / time scale)
+    within 10%: the walk does not start at double cadence before it locks to the CPG."""
+    expected = walk_cpg_period / GAIT_CONTROL["walk"].time_scale
+    for cond in (dict(), dict(friction_scale=0.7)):
+        v = validate("walk", seconds=8.0, **cond)
+        for leg, td in v.metrics.touchdowns.items():
+            d = np.diff(td)
+            assert len(d) >= 5 and np.all(np.abs(d / expected - 1) < 0.1), (cond, leg, d)
+
+
 def test_unstable_physics_is_reported_not_raised(tmp_path):
     for f in ("biped.xml", "scene.xml"):
         shutil.copy(BIPED_DIR / f, tmp_path / f)
