@@ -16,7 +16,7 @@ rescaled as validate does. Prints the best gains as Python.
 Without ``--start`` the first population is random over the ranges below; refining a preset
 (``--start``) stays in its basin. The present run came from a random population:
 
-    python scripts/tune_controller.py run --pop 60 --gens 60 --seed 7 \
+    python scripts/tune_controller.py run --pop 60 --gens 50 --seed 11 --min-speed 0.9 \
         --conditions table3,seed:10,seed:11,friction:0.7
 """
 from __future__ import annotations
