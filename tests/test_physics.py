@@ -13,6 +13,7 @@ and friction x0.7 / x1.3; one jump per CPG cycle.
 Hop (issue criteria: no fall, feet together within 0.1 stride, flight >= 15%, duty factor less
 than jump's, both classifiers agree): the same 13 conditions; one hop per CPG cycle.
 """
+import functools
 import shutil
 
 import numpy as np
@@ -55,8 +56,14 @@ def run_ok(s, walk_distance):
 
 
 @pytest.fixture(scope="module")
-def walk_distance():
-    return validate("walk", seconds=20.0).summary()["distance_m"]
+def walk_table3():
+    """The walk from the Table 3 state, 20 s: shared by the tests that only read it."""
+    return validate("walk", seconds=20.0)
+
+
+@pytest.fixture(scope="module")
+def walk_distance(walk_table3):
+    return walk_table3.summary()["distance_m"]
 
 
 @pytest.mark.parametrize("cond", CONDITIONS, ids=CONDITION_IDS)
@@ -108,27 +115,30 @@ def test_hop(cond, table3_duty):
 def test_one_take_off_per_cpg_cycle(gait):
     """The stride is the CPG's period / time scale: the rhythm is the network's, not a bounce
     of the body (two take-offs per cycle, or a period set by the legs, would fail)."""
-    from cpg.reproduce import run_preset
-
     v = validate(gait, seconds=20.0)
-    expected = run_preset(gait).rhythm.period / GAIT_CONTROL[gait].time_scale
+    expected = cpg_stride_s(gait)
     assert v.metrics.stride_period_s == pytest.approx(expected, rel=0.03)
     assert len(v.metrics.touchdowns["left"]) == pytest.approx(20.0 / expected, abs=2)
 
 
-@pytest.fixture(scope="module")
-def walk_cpg_period():
-    """The walk preset's CPG period (model units), from the network alone (no physics)."""
+@functools.cache
+def cpg_period(gait: str) -> float:
+    """The gait preset's CPG period (model units), from the network alone (no physics)."""
     from cpg.reproduce import run_preset
 
-    return run_preset("walk").rhythm.period
+    return run_preset(gait).rhythm.period
 
 
-def test_footfalls_follow_the_cpg_phase(walk_cpg_period):
+def cpg_stride_s(gait: str) -> float:
+    """Stride period (s) the CPG sets: its period (model units) / time scale (units per s)."""
+    return cpg_period(gait) / GAIT_CONTROL[gait].time_scale
+
+
+def test_footfalls_follow_the_cpg_phase():
     """Advance the CPG by half its period: left touchdowns move by half a stride."""
     p = GAIT_CONTROL["walk"]
     net = preset_network("walk")
-    period_model = walk_cpg_period
+    period_model = cpg_period("walk")
     strides = []
     for t0 in (0.0, period_model / 2):
         r = rollout(net, p, 12.0, t_model0=t0)
@@ -140,17 +150,15 @@ def test_footfalls_follow_the_cpg_phase(walk_cpg_period):
     assert abs(abs(shift / (2 * np.pi)) - 0.5) < 0.15
 
 
-def test_cpg_rhythm_sets_stride_period(walk_cpg_period):
+def test_cpg_rhythm_sets_stride_period(walk_table3):
     """Stride period (s) = CPG period (model units) / time scale (units per second)."""
-    v = validate("walk", seconds=20.0)
-    expected = walk_cpg_period / GAIT_CONTROL["walk"].time_scale
-    assert v.metrics.stride_period_s == pytest.approx(expected, rel=0.03)
+    assert walk_table3.metrics.stride_period_s == pytest.approx(cpg_stride_s("walk"), rel=0.03)
 
 
-def test_walk_steps_once_per_cpg_cycle_from_the_start(walk_cpg_period):
+def test_walk_steps_once_per_cpg_cycle_from_the_start():
     """Every touchdown interval after the 2 s settling is one stride (CPG period / time scale)
     within 10%: the walk does not start at double cadence before it locks to the CPG."""
-    expected = walk_cpg_period / GAIT_CONTROL["walk"].time_scale
+    expected = cpg_stride_s("walk")
     for cond in (dict(), dict(friction_scale=0.7)):
         v = validate("walk", seconds=8.0, **cond)
         for leg, td in v.metrics.touchdowns.items():
