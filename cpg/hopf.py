@@ -142,3 +142,140 @@ def random_states(n_osc: int, batch: int, seed: int = 0) -> np.ndarray:
 def primary_gait(gait: str, p: HopfParams = HopfParams(), **kw) -> Trajectory:
     """The four ankle cells (LF, RF, LE, RE) of a primary gait from one random start."""
     return simulate(gait_lags(gait), random_states(len(CELLS), 1, kw.pop("seed", 0)), p, **kw)
+
+
+# ------------------------------------------------------------------ compiled single network
+try:
+    import numba
+
+    @numba.njit(cache=True, inline="always")
+    def _rhs4(y, dy, mu, alpha, om_st, om_sw, a, k, normalised, C, S):
+        n = 4
+        for i in range(n):
+            x, v = y[i], y[n + i]
+            r2 = x * x + v * v
+            om = om_st / (np.exp(-a * v) + 1.0) + om_sw / (np.exp(a * v) + 1.0)
+            g = alpha * (mu - r2)
+            cx = 0.0
+            cy = 0.0
+            if normalised:
+                ri = np.sqrt(r2) + 1e-12
+                for j in range(n):
+                    if j != i:
+                        rj = np.sqrt(y[j] * y[j] + y[n + j] * y[n + j]) + 1e-12
+                        xn, vn = y[j] / rj, y[n + j] / rj
+                        cx += ri * (C[i, j] * xn - S[i, j] * vn) - x
+                        cy += ri * (S[i, j] * xn + C[i, j] * vn) - v
+            else:
+                for j in range(n):
+                    if j != i:
+                        cx += C[i, j] * y[j] - S[i, j] * y[n + j]
+                        cy += S[i, j] * y[j] + C[i, j] * y[n + j]
+            dy[i] = g * x - om * v + k * cx
+            dy[n + i] = om * x + g * v + k * cy
+
+    @numba.njit(cache=True)
+    def _kernel(y0, mu, alpha, a, k, normalised, beta_a, omsw_a, theta_a, beta_b, omsw_b,
+                theta_b, knot_t, knot_alpha, dt, n_steps, rec_start, rec_every, bound, out, final):
+        """RK4 of one 4-oscillator network; parameters blended along the knots (model time);
+        returns the step of divergence (0 = none)."""
+        y = y0.copy()
+        k1 = np.empty(8)
+        k2 = np.empty(8)
+        k3 = np.empty(8)
+        k4 = np.empty(8)
+        tmp = np.empty(8)
+        C = np.empty((4, 4))
+        S = np.empty((4, 4))
+        last = -1.0
+        om_st = 0.0
+        om_sw = 0.0
+        r = 0
+        n_rec = out.shape[0]
+        K = knot_t.shape[0]
+        for s in range(n_steps + 1):
+            if r < n_rec and s == rec_start + r * rec_every:
+                for i in range(4):
+                    out[r, i] = y[4 + i]
+                r += 1
+            if s == n_steps:
+                break
+            t = s * dt
+            al = 0.0
+            if K > 0:
+                if t <= knot_t[0]:
+                    al = knot_alpha[0]
+                elif t >= knot_t[K - 1]:
+                    al = knot_alpha[K - 1]
+                else:
+                    for q in range(1, K):
+                        if t < knot_t[q]:
+                            al = knot_alpha[q - 1] + (knot_alpha[q] - knot_alpha[q - 1]) * (
+                                t - knot_t[q - 1]) / (knot_t[q] - knot_t[q - 1])
+                            break
+            if al != last:
+                beta = beta_a + al * (beta_b - beta_a)
+                om_sw = omsw_a + al * (omsw_b - omsw_a)
+                om_st = (1.0 - beta) / beta * om_sw
+                for i in range(4):
+                    for j in range(4):
+                        th = theta_a[i, j] + al * (theta_b[i, j] - theta_a[i, j])
+                        C[i, j] = np.cos(th)
+                        S[i, j] = np.sin(th)
+                last = al
+            _rhs4(y, k1, mu, alpha, om_st, om_sw, a, k, normalised, C, S)
+            for q in range(8):
+                tmp[q] = y[q] + 0.5 * dt * k1[q]
+            _rhs4(tmp, k2, mu, alpha, om_st, om_sw, a, k, normalised, C, S)
+            for q in range(8):
+                tmp[q] = y[q] + 0.5 * dt * k2[q]
+            _rhs4(tmp, k3, mu, alpha, om_st, om_sw, a, k, normalised, C, S)
+            for q in range(8):
+                tmp[q] = y[q] + dt * k3[q]
+            _rhs4(tmp, k4, mu, alpha, om_st, om_sw, a, k, normalised, C, S)
+            for q in range(8):
+                y[q] += dt / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
+                if not (abs(y[q]) < bound):
+                    for rr in range(r, n_rec):
+                        for i in range(4):
+                            out[rr, i] = np.nan
+                    final[:] = np.nan
+                    return s + 1
+        final[:] = y
+        return 0
+
+    HAVE_NUMBA = True
+except ImportError:  # pragma: no cover - numba is a pinned dependency
+    HAVE_NUMBA = False
+
+
+def simulate_one(lags, y0, p: HopfParams, t_end: float, dt: float = 1e-3, t_record: float = 0.0,
+                 record_every: int = 1, to: tuple | None = None, knots=None) -> Trajectory:
+    """One 4-oscillator network (compiled): like :func:`simulate` without noise, records y
+    (1, T, 4). ``to`` = (lags_b, params_b) and ``knots`` = (t (K,), alpha (K,)) in seconds blend
+    the lags (hence theta), beta and omega_sw from this network's to ``to``'s."""
+    from .integrate import BLOWUP, _check_timing
+
+    n_steps, rec_start = _check_timing(t_end, dt, t_record, record_every)
+    theta_a = theta_matrix(lags)
+    y0 = np.asarray(y0, dtype=float).ravel()
+    if y0.shape != (8,) or not np.all(np.isfinite(y0)):
+        raise InputError("a Hopf state of four oscillators is 8 finite numbers")
+    if to is None:
+        theta_b, pb = theta_a, p
+        kt = ka = np.empty(0)
+    else:
+        theta_b, pb = theta_matrix(to[0]), to[1]
+        for name in ("mu", "alpha", "a", "k", "normalised"):
+            if getattr(pb, name) != getattr(p, name):
+                raise InputError(f"Hopf parameter {name} cannot change in mid-run")
+        kt, ka = (np.asarray(x, dtype=float) for x in knots)
+    rec = np.arange(rec_start, n_steps + 1, int(record_every))
+    out = np.empty((len(rec), 4))
+    final = np.empty(8)
+    div = _kernel(y0, p.mu, p.alpha, p.a, p.k, p.normalised, p.beta, p.omega_sw, theta_a,
+                  pb.beta, pb.omega_sw, theta_b, kt, ka, float(dt), n_steps, rec_start,
+                  int(record_every), BLOWUP, out, final)
+    diverged = np.array([div > 0])
+    return Trajectory(rec * dt, out[None], final[None], diverged,
+                      np.where(diverged, div * dt, np.nan))

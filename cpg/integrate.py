@@ -129,11 +129,35 @@ try:  # the compiled kernel; NumPy fallback keeps the package usable without num
             dy[4 + i] = (-m * ml.G_CA * (v - ml.V_CA) - y[i] * ml.G_K * (v - ml.V_K)
                          - ml.G_L * (v - ml.V_L) + i_app - coup)
 
+    @numba.njit(cache=True, inline="always")
+    def _blend_params(alpha, ia, pa, Wa, ib, pb, Wb, W_out, colsum):
+        """Parameters a + alpha (b - a) into W_out, colsum; returns (i_app, phi)."""
+        for i in range(4):
+            colsum[i] = 0.0
+        for j in range(4):
+            for i in range(4):
+                W_out[j, i] = Wa[j, i] + alpha * (Wb[j, i] - Wa[j, i])
+                colsum[i] += W_out[j, i]
+        return ia + alpha * (ib - ia), pa + alpha * (pb - pa)
+
+    @numba.njit(cache=True, inline="always")
+    def _alpha_at(s, knot_step, knot_alpha):
+        """Piecewise-linear schedule value at step s (knots sorted by step; held outside)."""
+        K = knot_step.shape[0]
+        if s <= knot_step[0]:
+            return knot_alpha[0]
+        for k in range(1, K):
+            if s < knot_step[k]:
+                s0, s1 = knot_step[k - 1], knot_step[k]
+                return knot_alpha[k - 1] + (knot_alpha[k] - knot_alpha[k - 1]) * (s - s0) / (s1 - s0)
+        return knot_alpha[K - 1]
+
     @numba.njit(cache=True, parallel=True)
-    def _ml_kernel(y0, i_app, phi, W, dt, n_steps, rec_start, rec_every, bound, out, final,
-                   div_step):
+    def _ml_kernel(y0, i_app, phi, W, i_app_b, phi_b, W_b, knot_step, knot_alpha, dt, n_steps,
+                   rec_start, rec_every, bound, out, final, div_step):
         B = y0.shape[0]
         n_rec = out.shape[1]
+        scheduled = knot_step.shape[0] > 0
         for b in numba.prange(B):
             y = y0[b].copy()
             k1 = np.empty(8)
@@ -141,11 +165,11 @@ try:  # the compiled kernel; NumPy fallback keeps the package usable without num
             k3 = np.empty(8)
             k4 = np.empty(8)
             tmp = np.empty(8)
-            Wb = W[b]
+            Wb = W[b].copy()
             colsum = np.zeros(4)
-            for i in range(4):
-                for j in range(4):
-                    colsum[i] += Wb[j, i]
+            ia, pa = _blend_params(0.0, i_app[b], phi[b], W[b], i_app_b[b], phi_b[b], W_b[b], Wb,
+                                   colsum)
+            last_alpha = 0.0
             r = 0
             for s in range(n_steps + 1):
                 if r < n_rec and s == rec_start + r * rec_every:
@@ -154,16 +178,22 @@ try:  # the compiled kernel; NumPy fallback keeps the package usable without num
                     r += 1
                 if s == n_steps:
                     break
-                _ml_f(y, k1, i_app[b], phi[b], Wb, colsum)
+                if scheduled:  # parameters held over each step, moved between steps
+                    alpha = _alpha_at(float(s), knot_step, knot_alpha)
+                    if alpha != last_alpha or s == 0:
+                        ia, pa = _blend_params(alpha, i_app[b], phi[b], W[b], i_app_b[b],
+                                               phi_b[b], W_b[b], Wb, colsum)
+                        last_alpha = alpha
+                _ml_f(y, k1, ia, pa, Wb, colsum)
                 for k in range(8):
                     tmp[k] = y[k] + 0.5 * dt * k1[k]
-                _ml_f(tmp, k2, i_app[b], phi[b], Wb, colsum)
+                _ml_f(tmp, k2, ia, pa, Wb, colsum)
                 for k in range(8):
                     tmp[k] = y[k] + 0.5 * dt * k2[k]
-                _ml_f(tmp, k3, i_app[b], phi[b], Wb, colsum)
+                _ml_f(tmp, k3, ia, pa, Wb, colsum)
                 for k in range(8):
                     tmp[k] = y[k] + dt * k3[k]
-                _ml_f(tmp, k4, i_app[b], phi[b], Wb, colsum)
+                _ml_f(tmp, k4, ia, pa, Wb, colsum)
                 ok = True
                 for k in range(8):
                     y[k] += dt / 6.0 * (k1[k] + 2.0 * k2[k] + 2.0 * k3[k] + k4[k])
@@ -185,22 +215,86 @@ except ImportError:  # pragma: no cover - numba is a pinned dependency
     HAVE_NUMBA = False
 
 
+@dataclass(frozen=True)
+class Schedule:
+    """A blend coefficient alpha(t) in [0, 1], piecewise linear in model time.
+
+    The parameters in force at model time t are p(t) = p_a + alpha(t) (p_b - p_a): the network
+    moves from parameter set a (alpha = 0) to b (alpha = 1) and its state carries across.
+    ``t`` (sorted) and ``alpha`` are the knots; alpha is held before the first knot and after
+    the last. A step at T is two knots at T; a ramp from T over R is knots at T and T + R.
+    """
+
+    t: tuple[float, ...]
+    alpha: tuple[float, ...]
+
+    def __post_init__(self):
+        t, a = np.asarray(self.t, dtype=float), np.asarray(self.alpha, dtype=float)
+        if t.ndim != 1 or t.shape != a.shape or len(t) == 0:
+            raise InputError("a schedule needs matching, non-empty knot times and values")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a))):
+            raise InputError("schedule knots must be finite")
+        if np.any(np.diff(t) < 0):
+            raise InputError("schedule knot times must be sorted")
+        if np.any(a < 0) or np.any(a > 1):
+            raise InputError("schedule values must lie in [0, 1]")
+
+    @classmethod
+    def change(cls, at: float, ramp: float = 0.0) -> "Schedule":
+        """From a to b at model time ``at``: a step (ramp 0) or a linear ramp over ``ramp``."""
+        if not (np.isfinite(at) and np.isfinite(ramp)) or ramp < 0:
+            raise InputError(f"a change needs a finite time and a ramp >= 0, got {at}, {ramp}")
+        return cls((at, at + ramp), (0.0, 1.0))
+
+    def at(self, t) -> np.ndarray:
+        """alpha at model times t (a step takes its new value at the step's time)."""
+        t = np.asarray(t, dtype=float)
+        knots_t, knots_a = np.asarray(self.t), np.asarray(self.alpha)
+        out = np.interp(t, knots_t, knots_a)
+        # np.interp is ambiguous at a repeated knot: take the last value given for that time.
+        for k in range(len(knots_t) - 1):
+            if knots_t[k] == knots_t[k + 1]:
+                out = np.where(t == knots_t[k], knots_a[k + 1], out)
+        return out
+
+    def scaled(self, factor: float) -> "Schedule":
+        """The same schedule with its times multiplied by ``factor`` (e.g. seconds -> model)."""
+        return Schedule(tuple(float(x) * factor for x in self.t), self.alpha)
+
+
 def simulate_ml(i_app, phi, W, y0, t_end: float = 500.0, dt: float = DT_ML,
                 t_record: float = 0.0, record_every: int = 1,
-                backend: str = "auto") -> Trajectory:
+                backend: str = "auto", to=None, schedule: Schedule | None = None) -> Trajectory:
     """Integrate a batch of 4-cell Morris–Lecar networks; records the voltages v (B, T, 4).
 
     i_app, phi: scalars or (B,); W: (4, 4) or (B, 4, 4) directed weights (``W[j, i]`` donor j,
     receiver i); y0: (8,) or (B, 8). Times in model units. ``backend`` is "numba", "numpy"
     or "auto" (numba when available).
+    ``to`` = (i_app_b, phi_b, W_b) and ``schedule``: the parameters move from the first set
+    to ``to`` along ``schedule`` (held constant over each step of ``dt``).
     """
     i_app, phi, W, y0 = ml.check_params(i_app, phi, W, y0)
+    if (to is None) != (schedule is None):
+        raise InputError("a parameter change needs both the target parameters and a schedule")
+    if to is None:
+        i_b, phi_b, W_b = i_app, phi, W
+    else:
+        i_b, phi_b, W_b, _ = ml.check_params(*to, y0)
+        if W_b.shape[0] != W.shape[0]:
+            raise InputError("the target parameters must have the batch size of the start")
     n_steps, rec_start = _check_timing(t_end, dt, t_record, record_every)
     if backend not in ("auto", "numba", "numpy"):
         raise InputError(f"unknown backend {backend!r}: use auto, numba or numpy")
     if backend == "numpy" or (backend == "auto" and not HAVE_NUMBA):
-        return rk4(lambda t, y, s: ml.rhs(y, i_app, phi, W), y0, t_end, dt, t_record,
-                   record_every, output=lambda y: y[:, ml.N_CELLS:], bound=ML_RANGE)
+        def f(t, y, s):
+            if schedule is None:
+                return ml.rhs(y, i_app, phi, W)
+            a = float(schedule.at(s * dt))  # held over the step, as in the kernel
+            return ml.rhs(y, i_app + a * (i_b - i_app), phi + a * (phi_b - phi),
+                          W + a * (W_b - W))
+
+        return rk4(f, y0, t_end, dt, t_record, record_every,
+                   output=lambda y: y[:, ml.N_CELLS:], bound=ML_RANGE)
     if not HAVE_NUMBA:
         raise InputError("backend 'numba' asked for, but numba is not installed")
     B = y0.shape[0]
@@ -208,8 +302,13 @@ def simulate_ml(i_app, phi, W, y0, t_end: float = 500.0, dt: float = DT_ML,
     out = np.empty((B, len(rec), ml.N_CELLS))
     final = np.empty((B, 2 * ml.N_CELLS))
     div_step = np.zeros(B, dtype=np.int64)
-    _ml_kernel(y0, i_app, phi, W, float(dt), n_steps, rec_start, int(record_every), ML_RANGE,
-               out, final, div_step)
+    if schedule is None:
+        knot_step = knot_alpha = np.empty(0)
+    else:
+        knot_step = np.asarray(schedule.t, dtype=float) / dt
+        knot_alpha = np.asarray(schedule.alpha, dtype=float)
+    _ml_kernel(y0, i_app, phi, W, i_b, phi_b, W_b, knot_step, knot_alpha, float(dt), n_steps,
+               rec_start, int(record_every), ML_RANGE, out, final, div_step)
     diverged = div_step > 0
     t_div = np.where(diverged, div_step * dt, np.nan)
     return Trajectory(rec * dt, out, final, diverged, t_div)

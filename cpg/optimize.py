@@ -224,6 +224,9 @@ class DaskEvaluator:
 
 
 # ---------------------------------------------------------------------------------- runner
+MAX_EVALUATIONS = 1_000_000  # population x generations of one search
+
+
 @dataclass
 class RunSettings:
     pop: int = 40
@@ -236,6 +239,11 @@ class RunSettings:
             raise InputError(f"population must be at least 4, got {self.pop}")
         if int(self.gens) < 1:
             raise InputError(f"generations must be at least 1, got {self.gens}")
+        if int(self.pop) * int(self.gens) > MAX_EVALUATIONS:
+            raise InputError(f"population x generations must be at most {MAX_EVALUATIONS:,}, "
+                             f"got {int(self.pop) * int(self.gens):,}")
+        if int(self.seed) < 0:
+            raise InputError(f"the seed must be a non-negative integer, got {self.seed}")
         if int(self.checkpoint_every) < 1:
             raise InputError(f"checkpoint interval must be at least 1, got {self.checkpoint_every}")
 
@@ -257,24 +265,60 @@ def _algorithm(pop: int):
     return NSGA2(pop_size=int(pop), eliminate_duplicates=True)
 
 
+# Checkpoint file: a header checked before anything is unpickled (unpickling runs code, so a
+# checkpoint from an untrusted source must never be loaded), then the pickled algorithm.
+#   line 1: CHECKPOINT_MAGIC   line 2: the format version   line 3: the run's settings (JSON)
+CHECKPOINT_MAGIC = b"cpgbiped checkpoint"
+CHECKPOINT_VERSION = 2
+
+
+def _meta_line(meta: dict) -> bytes:
+    import json
+
+    return json.dumps(meta, sort_keys=True, separators=(",", ":")).encode()
+
+
 def save_checkpoint(path: Path, algorithm, meta: dict) -> None:
     with atomic_path(path, suffix=".tmp") as tmp:
         with open(tmp, "wb") as f:
-            pickle.dump({"format": "cpgbiped.checkpoint/1", "meta": meta, "algorithm": algorithm}, f)
+            f.write(CHECKPOINT_MAGIC + b"\n" + str(CHECKPOINT_VERSION).encode() + b"\n"
+                    + _meta_line(meta) + b"\n")
+            pickle.dump(algorithm, f)
 
 
 def load_checkpoint(path: Path, meta: dict):
+    """The algorithm of a checkpoint written by this run's settings. The header (magic, format
+    version, settings) is checked first; only a matching file is unpickled."""
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+
+    name = str(path)
     try:
         with open(path, "rb") as f:
-            blob = pickle.load(f)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as e:
-        raise InputError(f"unreadable checkpoint {str(path)!r}: {e}") from None
-    if not isinstance(blob, dict) or blob.get("format") != "cpgbiped.checkpoint/1":
-        raise InputError(f"unreadable checkpoint {str(path)!r}: not a cpgbiped checkpoint")
-    if blob["meta"] != meta:
-        raise InputError(f"checkpoint {str(path)!r} belongs to another run "
-                         f"({blob['meta']}); delete it or use the same settings")
-    return blob["algorithm"]
+            magic, version, settings = (f.readline(4096).rstrip(b"\n") for _ in range(3))
+            if magic != CHECKPOINT_MAGIC:
+                raise InputError(f"unreadable checkpoint {name!r}: not a cpgbiped checkpoint "
+                                 f"(no header); delete it to start afresh")
+            if version != str(CHECKPOINT_VERSION).encode():
+                raise InputError(f"unreadable checkpoint {name!r}: format version "
+                                 f"{version.decode(errors='replace')}, this cpgbiped writes "
+                                 f"{CHECKPOINT_VERSION}; delete it to start afresh")
+            if settings != _meta_line(meta):
+                raise InputError(f"checkpoint {name!r} belongs to a run with other settings; "
+                                 f"delete it or use the same settings to resume")
+            algorithm = pickle.load(f)
+    except InputError:
+        raise
+    except OSError as e:
+        raise InputError(f"unreadable checkpoint {name!r}: {e.strerror}") from None
+    except (pickle.UnpicklingError, EOFError, AttributeError, ImportError, ValueError,
+            IndexError, TypeError) as e:
+        raise InputError(f"unreadable checkpoint {name!r}: {type(e).__name__}") from None
+    pop = getattr(algorithm, "pop", None)
+    if not isinstance(algorithm, NSGA2) or pop is None or np.asarray(pop.get("X")).ndim != 2 \
+            or np.asarray(pop.get("X")).shape[1] != meta["n_var"]:
+        raise InputError(f"unreadable checkpoint {name!r}: it does not hold an NSGA-II run of "
+                         f"this problem")
+    return algorithm
 
 
 def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None = None,

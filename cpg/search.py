@@ -18,12 +18,12 @@ import numpy as np
 from . import morris_lecar as ml
 from .errors import InputError
 from .evaluate import SimSettings, evaluate, robustness
-from .io import atomic_path, ensure_dir, write_json, write_text
+from .io import atomic_path, write_json, write_text
+from .outdir import ResultDir
+from .results import FORMAT, SECONDARY_FORMAT, load_result  # noqa: F401 (re-exported)
 from .optimize import (SECONDARY_TARGETS, PrimaryGaitProblem, RunSettings,
                        SymmetryBreakingProblem, run)
 
-FORMAT = "cpgbiped.optimize/1"
-SECONDARY_FORMAT = "cpgbiped.secondary/1"
 TIE_DEG = 0.01
 N_TIE_CANDIDATES = 8
 
@@ -81,24 +81,44 @@ def choose(X: np.ndarray, F: np.ndarray, robust_fn) -> tuple[int, np.ndarray]:
     return int(best), rob
 
 
-def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1.0,
+def checkpoint_name(gait: str) -> str:
+    return f"{gait}.checkpoint.pkl"
+
+
+def optimize_primary(gait: str, rs: RunSettings, out: "str | Path | ResultDir", lo: float = -1.0,
                      hi: float = 1.0, settings: SimSettings = SimSettings(), evaluator=None,
                      progress=None, n_robust: int = 50, stop_after: int | None = None,
                      robust_objective: int = 0, lock_objective: bool = False) -> dict:
     """Run NSGA-II for one primary gait; write DIR/<gait>.json, CSVs and the front PNG.
 
+    ``out`` is a folder (its files are replaced all at once when the run succeeds) or an open
+    :class:`cpg.outdir.ResultDir` that the caller commits. The checkpoint lives beside the
+    folder: an interrupted run resumes from it; a run that ends, or fails, removes it.
     ``robust_objective`` N > 0 adds the objective 1 - (fraction of N random initial states
     reaching the gait); ``lock_objective`` adds the time to lock (model units)."""
-    out = ensure_dir(out)
+    args = (gait, rs, lo, hi, settings, evaluator, progress, n_robust, stop_after,
+            robust_objective, lock_objective)
+    if isinstance(out, ResultDir):
+        return _optimize_primary(out, *args)
+    with ResultDir(out) as rd:
+        result = _optimize_primary(rd, *args)
+        rd.commit()
+    rd.state(checkpoint_name(gait)).unlink(missing_ok=True)
+    return result
+
+
+def _optimize_primary(rd: ResultDir, gait, rs, lo, hi, settings, evaluator, progress, n_robust,
+                      stop_after, robust_objective, lock_objective) -> dict:
     problem = PrimaryGaitProblem(gait, lo, hi, settings, evaluator, robust_objective,
                                  lock_objective)
     t0 = time.perf_counter()
-    res = run(problem, rs, checkpoint=out / f".{gait}.checkpoint.pkl", on_generation=progress,
-              stop_after=stop_after)
+    ckpt = rd.state(checkpoint_name(gait))
+    res = run(problem, rs, checkpoint=ckpt, on_generation=progress, stop_after=stop_after)
     ok = res.pareto_X
     F_opt = res.pareto_F
     feasible = res.G[:, 0] <= 0
     if not feasible.any():
+        ckpt.unlink(missing_ok=True)  # a failed run must not block the next one
         raise InputError(f"no feasible solution for {gait}: widen the bounds or the budget")
     rob_fn = lambda X: robustness(gait, problem.i_app, problem.phi, ml.weight_matrix(X),  # noqa: E731
                                   n_states=20, seed=rs.seed + 1)
@@ -137,42 +157,17 @@ def optimize_primary(gait: str, rs: RunSettings, out: str | Path, lo: float = -1
     # The final population with the reason each member passed or failed.
     ev = evaluate(gait, problem.i_app, problem.phi, ml.weight_matrix(res.X), problem.y0, settings)
     head = ["w_a", "w_b", "w_c", "z_RF", "z_LE", "z_RE", "constraint", "status", "classified"]
-    _csv(out / f"{gait}_population.csv", head,
+    _csv(rd.path(f"{gait}_population.csv"), head,
          [[*np.round(x, 6), *np.round(f, 6), round(float(g), 6), r, c]
           for x, f, g, r, c in zip(res.X, ev.F, ev.G, ev.reasons, ev.classified)])
-    _csv(out / f"{gait}_pareto.csv", ["w_a", "w_b", "w_c", *names, "robustness"],
+    _csv(rd.path(f"{gait}_pareto.csv"), ["w_a", "w_b", "w_c", *names, "robustness"],
          [[*np.round(x, 6), *np.round(f, 6), "" if not np.isfinite(r) else r]
           for x, f, r in zip(ok, F_opt, rob)])
-    _plot_front(out / f"{gait}_pareto.png", res.F[:, :3], F_opt[:, :3],
+    _plot_front(rd.path(f"{gait}_pareto.png"), res.F[:, :3], F_opt[:, :3],
                 f"{gait}: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed {rs.seed}",
                 ("z_RF", "z_LE", "z_RE"))
-    write_json(out / f"{gait}.json", result)
-    (out / f".{gait}.checkpoint.pkl").unlink(missing_ok=True)
+    write_json(rd.path(f"{gait}.json"), result)
     return result
-
-
-def load_result(path: str | Path) -> dict:
-    """A primary-gait result file, validated; clear errors for anything else."""
-    import json
-
-    p = Path(path)
-    try:
-        data = json.loads(p.read_text())
-    except FileNotFoundError:
-        raise InputError(f"result file {str(p)!r} does not exist") from None
-    except (OSError, ValueError) as e:
-        raise InputError(f"result file {str(p)!r} is not readable JSON: {e}") from None
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise InputError(f"{str(p)!r} is not a cpgbiped optimiser result (format {FORMAT})")
-    try:
-        w = np.array(data["chosen"]["weights"], dtype=float)
-        pareto = [np.array(q["weights"], dtype=float) for q in data["pareto"]]
-    except (KeyError, TypeError, ValueError):
-        raise InputError(f"{str(p)!r} lacks chosen/pareto weights") from None
-    for v in [w] + pareto:
-        if v.shape != (3,) or not np.all(np.isfinite(v)):
-            raise InputError(f"{str(p)!r} holds weights that are not three finite numbers")
-    return data
 
 
 # ------------------------------------------------------------------------------ secondary
@@ -242,6 +237,6 @@ def comparison_markdown(primary: dict[str, dict], secondary: list[dict] | None) 
     return "\n".join(lines) + "\n"
 
 
-def write_secondary(out: str | Path, results: list[dict]) -> Path:
-    return write_json(Path(out) / "secondary.json", {"format": SECONDARY_FORMAT,
-                                                     "targets": results})
+def write_secondary(path: str | Path, results: list[dict]) -> Path:
+    """The secondary-gait results file (``path``: the file, e.g. DIR/secondary.json)."""
+    return write_json(path, {"format": SECONDARY_FORMAT, "targets": results})

@@ -1,0 +1,152 @@
+"""All-or-nothing output folders, held by one run at a time.
+
+:class:`ResultDir` is what every command that writes a set of files into a folder uses
+(optimize, secondary, check-pareto, the demo):
+
+1. a lock file beside the folder (``.<name>.lock``, ``fcntl.flock``) keeps a second run out:
+   it gets a one-line error instead of silently replacing the first run's results;
+2. the run writes its files into a staging folder beside the target (same file system);
+3. ``commit()`` hard-links the target's other files (those the run does not replace) into the
+   staging folder and then exchanges the two folders in one step (Linux ``renameat2`` with
+   ``RENAME_EXCHANGE``); where the file system cannot exchange, it renames the target aside
+   and the staging folder in, and a later run restores the target if it was interrupted in
+   between. Either way the target holds the complete old set or the complete new set;
+4. on an error or Ctrl-C before the commit, the staging folder is removed and the target is
+   untouched; a target that did not exist is not created.
+Files the run must keep across an interrupt (checkpoints) live beside the target
+(:meth:`ResultDir.state`, ``.<name>.<file>``), never in the staging folder, so that an
+interrupted run can resume and a failed one leaves no folder behind.
+"""
+from __future__ import annotations
+
+import ctypes
+import errno
+import fcntl
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+from .errors import InputError
+
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (renameat2 RENAME_EXCHANGE); False where unsupported."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        fn = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    rc = fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE)
+    if rc == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):
+        return False
+    raise OSError(err, os.strerror(err), str(a))
+
+
+def _aside(target: Path) -> Path:
+    return target.parent / f".{target.name}.previous"
+
+
+def recover(target: Path) -> None:
+    """Finish an interrupted two-rename commit: the previous set comes back, or is dropped
+    when the new set is already in place."""
+    prev = _aside(target)
+    if prev.exists():
+        if target.exists():
+            shutil.rmtree(prev, ignore_errors=True)
+        else:
+            os.replace(prev, target)
+
+
+class ResultDir:
+    """A folder whose files a run replaces all at once (see the module docstring)."""
+
+    def __init__(self, target: str | os.PathLike):
+        self.target = Path(target).resolve()
+        self.staging: Path | None = None
+        self._lock_fd: int | None = None
+        self.committed = False
+
+    def state(self, name: str) -> Path:
+        """Where to keep run state (a checkpoint) called ``name``: beside the target."""
+        return self.target.parent / f".{self.target.name}.{name}"
+
+    def __enter__(self) -> "ResultDir":
+        parent = self.target.parent
+        if self.target.exists() and not self.target.is_dir():
+            raise InputError(f"output folder {str(self.target)!r} exists and is not a folder")
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise InputError(f"cannot create output folder {str(self.target)!r}: "
+                             f"{e.strerror}") from None
+        if not os.access(parent, os.W_OK) or (self.target.exists()
+                                              and not os.access(self.target, os.W_OK)):
+            raise InputError(f"output folder {str(self.target)!r} is not writable")
+        lock = parent / f".{self.target.name}.lock"
+        try:
+            self._lock_fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as e:
+            raise InputError(f"cannot create the lock file {str(lock)!r}: {e.strerror}") from None
+        try:
+            fcntl.flock(self._lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(self._lock_fd)
+            self._lock_fd = None
+            raise InputError(f"another cpgbiped run is writing to {str(self.target)!r}; wait for "
+                             f"it to finish or choose another --out") from None
+        recover(self.target)
+        self.staging = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.staging-", dir=parent))
+        return self
+
+    def path(self, name: str) -> Path:
+        """Where to write the result file ``name`` (inside the staging folder)."""
+        if self.staging is None:
+            raise RuntimeError("ResultDir used outside its with-block")
+        return self.staging / name
+
+    def commit(self) -> Path:
+        """Swap the staged files in (with the target's other files kept)."""
+        assert self.staging is not None
+        if self.target.exists():
+            for f in self.target.iterdir():
+                dst = self.staging / f.name
+                if dst.exists() or f.name.startswith(".") and f.name.endswith(".tmp"):
+                    continue
+                if f.is_dir():
+                    shutil.copytree(f, dst, copy_function=os.link)
+                else:
+                    os.link(f, dst)
+            mode = os.stat(self.target).st_mode & 0o777
+            os.chmod(self.staging, mode)
+            if _exchange(self.staging, self.target):
+                shutil.rmtree(self.staging, ignore_errors=True)
+            else:
+                os.replace(self.target, _aside(self.target))
+                os.replace(self.staging, self.target)
+                shutil.rmtree(_aside(self.target), ignore_errors=True)
+        else:
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(self.staging, 0o777 & ~umask)
+            os.replace(self.staging, self.target)
+        self.staging = None
+        self.committed = True
+        return self.target
+
+    def __exit__(self, *exc):
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging = None
+        if self._lock_fd is not None:
+            fcntl.flock(self._lock_fd, fcntl.LOCK_UN)
+            os.close(self._lock_fd)
+            self._lock_fd = None
+        return False
