@@ -1,13 +1,14 @@
 """Compiled (numba) control tick and recorder: the per-tick work of a rollout.
 
-The controller's arithmetic is documented in :mod:`envs.controller`; this module is its only
+The controller's equations are documented in :mod:`envs.controller`; this module is their only
 implementation. A control tick costs a few microseconds here against about 100 us as Python
 (NumPy's per-call overhead dominates arrays of 2-8 numbers), which is what lets a rollout run
 at more than half the speed of a bare ``mj_step`` loop (``scripts/bench_physics.py``).
 
 Inputs are raw views of MjData (qpos, qvel, sensordata, xpos) plus the integer addresses in
-``ix`` (layout ``IX_*``), the parameters as a float array in ``PARAM_NAMES`` order and the
-controller state as a float array (layout ``S_*``).
+``ix`` (layout ``IX_*``), the parameters as a float array (layout below), the
+controller state as a float array (layout ``S_*``) and the CPG schedule: raw outputs and
+activations (T, 4) on a uniform grid of ``dt_s`` seconds from t = 0.
 """
 from __future__ import annotations
 
@@ -16,13 +17,16 @@ import math
 import numpy as np
 from numba import njit
 
-# ControlParams fields, in the order the kernel unpacks them (checked in envs.controller).
-PARAM_NAMES = (
-    "time_scale", "v_half", "width", "pitch_d", "kp_t", "kd_t", "theta0", "c_v", "c_d", "kp_sw",
-    "kd_sw", "knee_swing", "knee_stance", "kp_knee", "kd_knee", "push", "ankle_gain",
-    "swing_margin", "two_legged", "knee_crouch", "kp_crouch", "kp_land", "k_ax", "k_av", "kf_t",
-    "contact_hold",
-)
+# Parameter layout (the float array P; envs.controller.params_array builds it):
+# the shared parameters, then each blended gain's values at the four pattern corners, in
+# CORNER order: (sigma, kappa) = (0, 0), (0, 1), (1, 0), (1, 1).
+SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold")
+BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
+           "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
+           "kp_air", "kd_knee", "push")
+CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
+N_SHARED = len(SHARED)
+P_SIZE = N_SHARED + 4 * len(BLENDED)
 
 # ix layout: MjData addresses.
 (IX_ROOTY_Q, IX_ROOTY_V, IX_HIP_Q, IX_HIP_V, IX_KNEE_Q, IX_KNEE_V, IX_FORCE, IX_COM, IX_COMVEL,
@@ -30,13 +34,24 @@ PARAM_NAMES = (
     0, 1, 2, 4, 6, 8, 10, 12, 13, 14, 16, 17, 18, 19)  # pairs are (left, right); joints: 6
 IX_SIZE = 25
 
-# Controller state layout.
-S_STANCE, S_STANCE_X, S_LAST_GROUND, S_WAS_GROUND, S_PUSHED, S_X0 = 0, 2, 4, 5, 6, 7
-S_SIZE = 8
+# Controller state layout (pairs are left, right).
+S_LAST_GROUND, S_WAS_GROUND, S_PUSHED, S_SWUNG, S_MODE = 0, 2, 4, 6, 8
+# Running averages behind the CPG features: sigma (left-right synchrony of the extensors) and
+# kappa (flexor-extensor co-activation).
+S_LAST_T, S_C_LR, S_V_L, S_V_R, S_SYNC, S_C_FE, S_V_F, S_V_E, S_COACT = 10, 11, 12, 13, 14, 15, 16, 17, 18
+S_GROUNDED_IN_BURST = 19  # pair: the leg stood on the ground during its present burst
+S_SIZE = 21
+TAU_FEATURE = 0.5  # s: time constant of those running averages
+# Leg modes (S_MODE), for recordings and tests.
+MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
 
 # Recording columns, one row per control tick.
-R_T, R_CONTACT, R_FORCE, R_V, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX = 0, 1, 3, 5, 9, 13, 19, 20, 21
-R_SIZE = 22
+# R_V: CPG outputs; R_DRIVE: their activations (the CPG's drive); R_ACT: the ankle muscles'
+# activation state (MjData.act); R_CTRL: the 8 controls sent; R_POWER: each actuator's
+# mechanical power (actuator force x actuator velocity, W; the actuator order of the model).
+(R_T, R_CONTACT, R_FORCE, R_V, R_DRIVE, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX, R_COMZ,
+ R_MODE, R_CTRL, R_POWER) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37)
+R_SIZE = 45
 
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (biped.xml)
@@ -44,10 +59,9 @@ FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (b
 
 def new_state() -> np.ndarray:
     s = np.zeros(S_SIZE)
-    s[S_STANCE:S_STANCE + 2] = 1.0
-    s[S_LAST_GROUND] = -1.0
-    s[S_WAS_GROUND] = 1.0
-    s[S_X0] = np.nan  # two-legged gaits: COM x at the first tick (hop in place around it)
+    s[S_LAST_GROUND:S_LAST_GROUND + 2] = 0.0  # the body starts standing on both feet
+    s[S_WAS_GROUND:S_WAS_GROUND + 2] = 1.0
+    s[S_LAST_T] = -1.0
     return s
 
 
@@ -56,142 +70,182 @@ def _clip1(x):
     return min(1.0, max(-1.0, x))
 
 
-@njit(cache=True)
-def sample_cpg(sched_v, dt_model, t_model, v_out):
-    """Linear interpolation of the CPG schedule (T, 4) at model time t_model."""
-    k = min(int(t_model / dt_model), sched_v.shape[0] - 2)
-    f = t_model / dt_model - k
-    for c in range(4):
-        v_out[c] = (1.0 - f) * sched_v[k, c] + f * sched_v[k + 1, c]
+@njit(cache=True, inline="always")
+def _clip01(x):
+    return min(1.0, max(0.0, x))
 
 
 @njit(cache=True)
-def control(t_s, t_model0, sched_v, dt_model, P, S, qpos, qvel, sens, xpos, ix, u, v_out):
-    """Write the 8 controls for time t_s (s) into u and the CPG outputs into v_out."""
-    (time_scale, v_half, width, pitch_d, kp_t, kd_t, theta0, c_v, c_d, kp_sw, kd_sw, knee_swing,
-     knee_stance, kp_knee, kd_knee, push, ankle_gain, swing_margin, two_legged, knee_crouch,
-     kp_crouch, kp_land, k_ax, k_av, kf_t, contact_hold) = (
-        P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11], P[12], P[13],
-        P[14], P[15], P[16], P[17], P[18], P[19], P[20], P[21], P[22], P[23], P[24], P[25])
-    sample_cpg(sched_v, dt_model, t_model0 + time_scale * t_s, v_out)
-    a = np.empty(4)
+def sample(sched, dt_s, t_s, out):
+    """Linear interpolation of a schedule (T, 4) on a grid of dt_s seconds at time t_s."""
+    x = t_s / dt_s
+    k = min(max(int(x), 0), sched.shape[0] - 2)
+    f = min(max(x - k, 0.0), 1.0)
     for c in range(4):
-        a[c] = 1.0 / (1.0 + math.exp(-(v_out[c] - v_half) / width))
-    contact = np.empty(2, dtype=np.bool_)
+        out[c] = (1.0 - f) * sched[k, c] + f * sched[k + 1, c]
+
+
+@njit(cache=True)
+def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_out, a_out):
+    """Write the 8 controls for time t_s (s) into u, the CPG outputs into v_out and the
+    activations into a_out."""
+    ankle_gain, e_on, w_flex, w_cross, contact_hold = P[0], P[1], P[2], P[3], P[4]
+    sample(sched_v, dt_s, t_s, v_out)
+    sample(sched_a, dt_s, t_s, a_out)
+    a = a_out
+    # Per leg i (0 left, 1 right): flexor f = a[i], extensor e = a[2 + i].
+    e = np.empty(2)
+    f = np.empty(2)
+    g = np.empty(2)
     for i in range(2):
-        contact[i] = abs(sens[ix[IX_FORCE + i]]) > CONTACT_N
+        e[i] = a[2 + i]
+        f[i] = a[i]
+    for i in range(2):  # swing drive: own flexor or the other leg's extensor (crossed)
+        g[i] = (1.0 - e[i]) * _clip01(w_flex * f[i] + w_cross * e[1 - i])
+    # CPG features in [0, 1], from running averages <.> (time constant TAU_FEATURE):
+    # sigma = <e_L e_R> / sqrt(<e_L^2> <e_R^2>)  (left-right synchrony of the extensors),
+    # kappa = <f_L e_L + f_R e_R> / sqrt(<f_L^2 + f_R^2> <e_L^2 + e_R^2>)  (co-activation).
+    if S[S_LAST_T] >= 0.0:
+        w = 1.0 - math.exp(-(t_s - S[S_LAST_T]) / TAU_FEATURE)
+        S[S_C_LR] += w * (e[0] * e[1] - S[S_C_LR])
+        S[S_V_L] += w * (e[0] * e[0] - S[S_V_L])
+        S[S_V_R] += w * (e[1] * e[1] - S[S_V_R])
+        S[S_C_FE] += w * (f[0] * e[0] + f[1] * e[1] - S[S_C_FE])
+        S[S_V_F] += w * (f[0] * f[0] + f[1] * f[1] - S[S_V_F])
+        S[S_V_E] += w * (e[0] * e[0] + e[1] * e[1] - S[S_V_E])
+    S[S_LAST_T] = t_s
+    sigma = _clip01(S[S_C_LR] / (math.sqrt(S[S_V_L] * S[S_V_R]) + 1e-3))
+    kappa = _clip01(S[S_C_FE] / (math.sqrt(S[S_V_F] * S[S_V_E]) + 1e-3))
+    S[S_SYNC] = sigma
+    S[S_COACT] = kappa
+    # Blended gains: bilinear in (sigma, kappa) between their values at the four corners.
+    w00 = (1.0 - sigma) * (1.0 - kappa)
+    w01 = (1.0 - sigma) * kappa
+    w10 = sigma * (1.0 - kappa)
+    w11 = sigma * kappa
+    G = np.empty(len(BLENDED))
+    for n in range(len(BLENDED)):
+        q = N_SHARED + 4 * n
+        G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
+    (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
+     knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push) = (
+        G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
+        G[14], G[15], G[16], G[17], G[18], G[19])
+    kp_knee = max(0.0, kp_knee)
+    kp_push = max(0.0, kp_push)
+    kp_air = max(0.0, kp_air)
+
     pitch = -qpos[ix[IX_ROOTY_Q]]
     pitch_rate = -qvel[ix[IX_ROOTY_V]]
     com_x = sens[ix[IX_COM]]
     com_v = sens[ix[IX_COMVEL]]
+    ground = np.empty(2, dtype=np.bool_)
     thigh = np.empty(2)
     thigh_rate = np.empty(2)
     knee = np.empty(2)
     knee_rate = np.empty(2)
-    ankle_x = np.empty(2)
+    foot_x = np.empty(2)
     for i in range(2):
+        if abs(sens[ix[IX_FORCE + i]]) > CONTACT_N:
+            S[S_LAST_GROUND + i] = t_s
+        ground[i] = t_s - S[S_LAST_GROUND + i] <= contact_hold
         thigh[i] = qpos[ix[IX_HIP_Q + i]] + qpos[ix[IX_ROOTY_Q]]
         thigh_rate[i] = qvel[ix[IX_HIP_V + i]] + qvel[ix[IX_ROOTY_V]]
         knee[i] = qpos[ix[IX_KNEE_Q + i]]
         knee_rate[i] = qvel[ix[IX_KNEE_V + i]]
-        ankle_x[i] = xpos[ix[IX_FOOT + i], 0]
-    tau_torso = kp_t * (pitch_d - pitch) - kd_t * pitch_rate
+        foot_x[i] = xpos[ix[IX_FOOT + i], 0] + FOOT_CENTRE_X
+
+    # Latches, one per leg, that follow the CPG's bursts: a leg pushes once per extensor burst
+    # (a landing inside the same burst is absorbed) and lifts once per swing. A leg has taken
+    # off when it is off the ground after standing in this burst while the other leg is not
+    # still pushing on the ground (a foot that rolls off while its partner pushes has not).
+    stance_cmd = np.empty(2, dtype=np.bool_)
+    for i in range(2):
+        stance_cmd[i] = e[i] >= e_on
+    for i in range(2):
+        j = 1 - i
+        if stance_cmd[i]:
+            S[S_SWUNG + i] = 0.0
+            if ground[i]:
+                S[S_GROUNDED_IN_BURST + i] = 1.0
+            elif S[S_GROUNDED_IN_BURST + i] > 0.5 and not (ground[j] and stance_cmd[j]):
+                S[S_PUSHED + i] = 1.0
+        else:
+            S[S_PUSHED + i] = 0.0
+            S[S_GROUNDED_IN_BURST + i] = 0.0
+            if not ground[i] and S[S_WAS_GROUND + i] > 0.5:
+                S[S_SWUNG + i] = 1.0
+    for i in range(2):
+        S[S_WAS_GROUND + i] = 1.0 if ground[i] else 0.0
+
+    # Modes: a grounded leg lifts into swing only while the other leg carries the body; a foot
+    # that merely unloads (no swing, the other foot down) keeps its support behaviour.
+    mode = np.empty(2)
+    n_support = 0
+    sup_x = 0.0
+    for i in range(2):
+        j = 1 - i
+        if not ground[i] and (S[S_SWUNG + i] > 0.5 or not ground[j]):
+            mode[i] = MODE_AIR
+        elif ground[i] and g[i] > 0.5 and S[S_SWUNG + i] < 0.5 and ground[j] and stance_cmd[j]:
+            mode[i] = MODE_LIFT
+        else:
+            mode[i] = MODE_SUPPORT
+            n_support += 1
+            sup_x += foot_x[i]
+        S[S_MODE + i] = mode[i]
+
+    # Ankles: the CPG's drive at one gain; a balance reflex adds to it on the ground.
     for c in range(4):
         u[c] = ankle_gain * a[c]
-
-    if two_legged > 0.5:
-        if math.isnan(S[S_X0]):
-            S[S_X0] = com_x
-        burst = (a[2] + a[3]) / 2 > 0.5  # the extensor burst: push-off
-        if contact[0] or contact[1]:
-            S[S_LAST_GROUND] = t_s
-        ground = t_s - S[S_LAST_GROUND] < contact_hold
-        if not burst:
-            S[S_PUSHED] = 0.0
-        elif not ground and S[S_WAS_GROUND] > 0.5:
-            S[S_PUSHED] = 1.0  # lifted off: one push per burst
-        S[S_WAS_GROUND] = 1.0 if ground else 0.0
-        S[S_STANCE] = S[S_STANCE + 1] = 1.0 if ground else 0.0
-        push_now = burst and S[S_PUSHED] < 0.5
-        if ground and k_ax != 0.0:  # ankle balance reflex on top of the CPG drive
-            b = k_ax * (com_x - (ankle_x[0] + ankle_x[1]) / 2 - FOOT_CENTRE_X) + k_av * com_v
-            if b > 0:
-                u[2] = min(u[2] + b, 1.0)
-                u[3] = min(u[3] + b, 1.0)
-            else:
-                u[0] = min(u[0] - b, 1.0)
-                u[1] = min(u[1] - b, 1.0)
-        theta = theta0 + c_v * com_v + c_d * (com_x - S[S_X0])
+    tau_torso = kp_t * (pitch_d - pitch) - kd_t * pitch_rate
+    if n_support > 0:
+        sup_x /= n_support
+        b = k_ax * (com_x - sup_x) + k_av * com_v
         for i in range(2):
-            if ground:
-                hip = tau_torso / 2
-                if push_now:
-                    k = kp_knee * (knee_stance - knee[i]) - kd_knee * knee_rate[i] + push
+            if mode[i] == MODE_SUPPORT:
+                if b > 0:
+                    u[2 + i] = min(u[2 + i] + b, 1.0)
                 else:
-                    k = kp_crouch * (knee_crouch - knee[i]) - kd_knee * knee_rate[i]
-            else:
-                hip = kp_sw * (theta - thigh[i]) - kd_sw * thigh_rate[i] - kf_t * tau_torso
-                k = kp_land * (knee_swing - knee[i]) - kd_knee * knee_rate[i]
-            u[4 + i] = _clip1(hip)
-            u[6 + i] = _clip1(k)
-        return
+                    u[i] = min(u[i] - b, 1.0)
+        ref_x = sup_x
+    else:
+        ref_x = com_x
 
-    # Alternating gaits: the leg whose extensor is clearly the weaker one swings.
-    swing_cmd = np.empty(2, dtype=np.bool_)
-    swing_cmd[0] = a[2] < a[3] - swing_margin
-    swing_cmd[1] = a[3] < a[2] - swing_margin
-    stance = np.empty(2, dtype=np.bool_)
-    for i in range(2):
-        stance[i] = not swing_cmd[i]
-    for i in range(2):  # contact priority: never swing away the only support
-        if swing_cmd[i] and contact[i] and not contact[1 - i]:
-            stance[i] = True
-    if not (stance[0] or stance[1]):  # flight in a run: keep the leg commanded to stance
-        for i in range(2):
-            stance[i] = not swing_cmd[i]
-    for i in range(2):
-        if stance[i] and S[S_STANCE + i] < 0.5:
-            S[S_STANCE_X + i] = ankle_x[i]
-        S[S_STANCE + i] = 1.0 if stance[i] else 0.0
-    support = np.empty(2, dtype=np.bool_)
-    n_support = 0
-    ref_x = 0.0
-    for i in range(2):  # only a grounded foot holds the torso
-        support[i] = stance[i] and contact[i]
-        if support[i]:
-            n_support += 1
-            ref_x += S[S_STANCE_X + i]
-    ref_x = ref_x / n_support if n_support else com_x
+    # Hips: legs off the ground (or lifting) place the foot; support legs hold the torso.
+    theta = theta0 + c_v * com_v + c_d * (com_x - ref_x)
     tau_hip = np.zeros(2)
+    swing_sum = 0.0
     for i in range(2):
-        if not support[i]:
-            # Swing: place the foot; a stance-commanded foot in the air holds a landing pose.
-            if not stance[i]:
-                target = theta0 + c_v * com_v + c_d * (com_x - ref_x)
-            else:
-                target = c_v * com_v
-            tau_hip[i] = kp_sw * (target - thigh[i]) - kd_sw * thigh_rate[i]
-    # Hip torque on the thigh reacts on the torso: forward torso torque = +sum(tau_hip).
-    if n_support:
-        share = tau_torso
+        if mode[i] != MODE_SUPPORT:
+            tau_hip[i] = kp_sw * (theta - thigh[i]) - kd_sw * thigh_rate[i]
+            if n_support == 0:
+                tau_hip[i] -= kf_t * tau_torso
+            swing_sum += tau_hip[i]
+    if n_support > 0:  # hip torque on a thigh reacts on the torso: forward torque = sum(tau_hip)
+        share = (tau_torso - swing_sum) / n_support
         for i in range(2):
-            if not support[i]:
-                share -= tau_hip[i]
-        share /= n_support
-        for i in range(2):
-            if support[i]:
+            if mode[i] == MODE_SUPPORT:
                 tau_hip[i] = share
+
+    # Knees: support legs extend with the extensor burst (once per burst) and crouch outside
+    # it; legs in the air flex with the swing drive and extend to land without it.
     for i in range(2):
-        if stance[i]:
-            k = kp_knee * (knee_stance - knee[i]) - kd_knee * knee_rate[i] + push * a[2 + i]
+        if mode[i] == MODE_SUPPORT:
+            drive = e[i] * (1.0 - S[S_PUSHED + i])
+            target = knee_crouch + (knee_ext - knee_crouch) * drive
+            kp = kp_knee + (kp_push - kp_knee) * drive
+            k = kp * (target - knee[i]) - kd_knee * knee_rate[i] + push * drive
         else:
-            k = kp_knee * (knee_swing - knee[i]) - kd_knee * knee_rate[i]
+            target = knee_land + (knee_swing - knee_land) * g[i]
+            k = kp_air * (target - knee[i]) - kd_knee * knee_rate[i]
         u[4 + i] = _clip1(tau_hip[i])
         u[6 + i] = _clip1(k)
 
 
 @njit(cache=True)
-def record(k, t_s, qpos, sens, xpos, act, ix, v, rec, fall_height, fall_pitch):
+def record(k, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, S, rec, fall_height,
+           fall_pitch):
     """Write row k of the recording; return 0 (fine), 1 (fallen) or 2 (non-finite state)."""
     for j in range(qpos.shape[0]):
         if not math.isfinite(qpos[j]):
@@ -202,9 +256,14 @@ def record(k, t_s, qpos, sens, xpos, act, ix, v, rec, fall_height, fall_pitch):
         f = abs(sens[ix[IX_FORCE + i]])
         r[R_FORCE + i] = f
         r[R_CONTACT + i] = 1.0 if f > CONTACT_N else 0.0
+        r[R_MODE + i] = S[S_MODE + i]
     for c in range(4):
         r[R_V + c] = v[c]
+        r[R_DRIVE + c] = a[c]
         r[R_ACT + c] = act[c]
+    for c in range(8):
+        r[R_CTRL + c] = ctrl[c]
+        r[R_POWER + c] = afrc[c] * avel[c]
     for j in range(6):
         r[R_JOINTS + j] = qpos[ix[IX_JOINTS + j]]
     h = xpos[ix[IX_TORSO], 2]
@@ -212,6 +271,7 @@ def record(k, t_s, qpos, sens, xpos, act, ix, v, rec, fall_height, fall_pitch):
     r[R_HEIGHT] = h
     r[R_PITCH] = pitch
     r[R_COMX] = sens[ix[IX_COM]]
+    r[R_COMZ] = sens[ix[IX_COM] + 2]
     body_down = False
     for j in range(ix[IX_N_BODY_FLOOR]):
         if sens[ix[IX_BODY_FLOOR] + j] > 0:
@@ -219,3 +279,15 @@ def record(k, t_s, qpos, sens, xpos, act, ix, v, rec, fall_height, fall_pitch):
     if h < fall_height or abs(pitch) > fall_pitch or body_down:
         return 1
     return 0
+
+
+@njit(cache=True)
+def record_pose(k, qpos, xpos, xquat, qpos_rec, pose_rec):
+    """Row k of the joint positions and of every body's world pose (x y z, quaternion w x y z)."""
+    for j in range(qpos.shape[0]):
+        qpos_rec[k, j] = qpos[j]
+    for b in range(xpos.shape[0]):
+        for c in range(3):
+            pose_rec[k, b, c] = xpos[b, c]
+        for c in range(4):
+            pose_rec[k, b, 3 + c] = xquat[b, c]

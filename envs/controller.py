@@ -1,162 +1,228 @@
-"""The CPG in the loop: time scale, activation map, pattern formation and balance.
+"""The one controller: any network's four ankle cells plus the body's sensors -> 8 controls.
 
-Data flow per control tick (every ``control_every`` physics steps, ctrl held in between):
-1. CPG. The 4-cell network has no feedback, so it is integrated ahead for the whole rollout
-   in one batched call (:func:`cpg.integrate.simulate_ml`) and sampled at the tick:
-   t_model = t_model0 + time_scale * t_s (``time_scale`` model units per second).
-2. Activation map. Cell output v -> muscle activation a = 1 / (1 + exp(-(v - v_half) / width))
-   in [0, 1]; a_LF, a_RF, a_LE, a_RE drive the ankle flexor/extensor actuators directly.
-3. Pattern formation (timing from the CPG only).
-   - Alternating gaits (walk, run: the legs' extensor cells in antiphase): the leg whose
-     extensor activation is below the other's by more than ``swing_margin`` has the swing
-     command (the margin leaves both legs in stance around the switch: double support).
-   - Two-legged gaits (jump, hop: extensors in phase): the extensor burst (mean a_E > 0.5) is
-     the push-off. On the ground during the burst both knees extend (PD to ``knee_stance`` plus
-     ``push``), once per burst: after lift-off a landing inside the same burst is absorbed, not
-     pushed again, so there is one jump per CPG cycle. Outside the burst the knees hold a
-     compliant crouch (``knee_crouch``, ``kp_crouch``) that absorbs the landing and loads the
-     next push; in the air they take the landing pose (``knee_swing``, ``kp_land``).
-4. Balance (stance read from the foot contact sensors).
-   Alternating gaits, SIMBICON-style:
-   - contact priority: a foot on the ground stays a stance foot while the other leg is in the
-     air and not commanded to stance (never swing away the only support);
-   - stance hips hold the torso pitch: tau_torso = kp_t (pitch_d - pitch) - kd_t pitch_rate,
-     shared by the stance legs; with one stance leg it also cancels the swing hip torque;
-   - swing hips place the foot: thigh angle in the world
-     theta_sw = theta0 + c_v * v_com + c_d * (x_com - x_stance_ankle) (Raibert/SIMBICON);
-   - knees: stance knees straighten (plus a push torque proportional to the extensor
-     activation), swing knees flex for clearance.
-   Two-legged gaits, Raibert-hopper style ("on the ground" = a foot touched the floor within
-   the last ``contact_hold`` s, which bridges contact chatter):
-   - on the ground the hips hold the torso pitch (tau_torso shared by both legs), and an
-     ankle balance reflex keeps the centre of mass over the feet: b = k_ax (x_com - x_feet)
-     + k_av v_com is added to the extensor activations when b > 0 (COM ahead: plantarflex,
-     which pushes the body back) and -b to the flexor activations when b < 0; the CPG's
-     activation is the base drive, the reflex only adds to it (both clipped to [0, 1]);
-   - in the air the hips place both feet: theta = theta0 + c_v v_com + c_d (x_com - x_com(0))
-     in the world (Raibert foot placement; the c_d term holds the hop in place), minus
-     ``kf_t`` tau_torso (the legs' swing reacts on the torso, so kf_t trades foot placement
-     for torso attitude).
-Sign conventions (see models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
+It never receives a gait name, a preset name or a classifier's verdict, and it has one
+parameter set (:data:`CONTROL`) for every gait and every network. Everything that differs
+between gaits comes from the CPG's activations, tick by tick.
+
+Per control tick (every ``control_every`` physics steps; ctrl held in between):
+
+1. CPG. The network has no feedback, so it is integrated ahead from its initial state at
+   t = 0 (when the body starts) and sampled at the tick: t_model = units_per_s * t_s, with
+   the network's fixed time unit (:mod:`cpg.network`). The schedule holds the raw outputs v
+   and the activations a = network.activation(v) in [0, 1] of the cells LF, RF, LE, RE.
+   Per leg i (j the other leg): flexor f_i = a_iF, extensor e_i = a_iE,
+   - swing drive     g_i = (1 - e_i) clip(w_flex f_i + w_cross e_j, 0, 1)
+     (the leg's own flexor burst, or the other leg's extensor burst - a crossed extension -
+     while its own extensor is silent),
+   - stance command  e_i >= e_on,
+   and two features of the rhythm, measured online from the CPG signals (<.> running averages
+   with a time constant of 0.5 s), both in [0, 1]:
+     sigma = <e_L e_R> / sqrt(<e_L^2> <e_R^2>)   left-right synchrony of the extensors
+             (1 in phase, 0 in antiphase);
+     kappa = <f_L e_L + f_R e_R> / sqrt(<f_L^2 + f_R^2> <e_L^2 + e_R^2>)   flexor-extensor
+             co-activation (1 co-active: a stiff ankle; 0 alternating: the ankle rotates).
+   The balance and pattern gains (:class:`Corner`: reflex, torso, foot placement, knee) vary
+   continuously with them, bilinearly between their values at the four corners of the
+   (sigma, kappa) square:
+     p = (1-sigma)(1-kappa) p_alternating + (1-sigma) kappa p_alternating_coactive
+         + sigma (1-kappa) p_synchronous + sigma kappa p_synchronous_coactive.
+   A rhythm between the corners (a transition, a secondary gait, other weights) gets gains
+   between theirs. The ankle gain, the swing wiring (e_on, w_flex, w_cross) and contact_hold
+   are shared by all. Nothing depends on a name.
+2. Contacts and modes. A foot is on the ground while its contact force exceeds 1 N or did
+   within the last ``contact_hold`` s. Each leg is in one mode:
+   - air: its foot is off the ground and the leg swings (it lifted in this swing) or the
+     other foot is off the ground too;
+   - lift: on the ground, g_i > 0.5, not yet lifted in this swing, and the other leg is on the
+     ground with its stance command (a leg never lifts away the only support);
+   - support: otherwise (on the ground, or a foot that merely unloads while the other one
+     stands).
+   Two latches per leg follow the CPG's bursts, never a clock: "pushed" (the leg took off
+   during its extensor burst: it stood on the ground in this burst and is now off it while
+   the other leg is not still pushing on the ground; a landing in the same burst is absorbed,
+   not pushed again) and "swung" (the leg left the ground during its swing; a landing before
+   its next burst stays down). Both clear when the burst state changes.
+3. Ankles: u_muscle = ankle_gain a (each muscle its own cell's activation; one gain for every
+   gait and network). A balance reflex adds to it on the ground (never replaces it):
+   b = k_ax (x_com - x_sup) + k_av v_com with x_sup the mean centre of the support feet;
+   b > 0 (centre of mass ahead) adds b to the support legs' extensors, b < 0 adds -b to their
+   flexors; clipped to [0, 1]. ``--no-ankle-drive`` sets ankle_gain = 0 (the reflex stays).
+4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
+   tau_torso = kp_t (pitch_d - pitch) - kd_t pitch_rate;
+   legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
+   thigh angle in the world as target
+       theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
+       tau_i = kp_sw (theta - thigh_i) - kd_sw thigh_rate_i  [ - kf_t tau_torso in flight ];
+   support legs share what holds the torso: tau_i = (tau_torso - sum of the others' tau) / n.
+5. Knees:
+   support: drive d_i = e_i (1 - pushed_i); target knee_crouch + (knee_ext - knee_crouch) d_i,
+       stiffness kp = kp_knee + (kp_push - kp_knee) d_i,
+       tau = kp (target - q) - kd_knee q_rate + push d_i
+       (the extensor burst extends the leg - the push-off; outside it the knee yields to a
+       crouch that absorbs the landing and loads the next push);
+   air and lift: target knee_land + (knee_swing - knee_land) g_i,
+       tau = kp_air (target - q) - kd_knee q_rate
+       (the swing drive tucks the leg; without it the leg extends to land).
+
+What makes the gaits differ is the CPG: left-right extensors in antiphase give alternating
+support (walk, run), in phase both legs push and fly together (jump, hop); synchrony (sigma)
+and flexor-extensor co-activation (kappa) set the leg's stiffness, push, posture and balance
+strategy; the network's period sets the cadence; the ankle muscles follow their cells.
+
+Sign conventions (models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
 the leg forward; knee angle <= 0 (negative = flexed); ankle > 0 lifts the toes; torso pitch
 from the torso's up axis, > 0 leaning forward.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from cpg import morris_lecar as ml
 from cpg.errors import InputError
-from cpg.integrate import simulate_ml
+from cpg.integrate import Schedule
+from cpg.network import Network
 
 from . import control_kernel as kernel
 
 
+@dataclass(frozen=True)
+class Corner:
+    """The blended gains at one corner of the (sigma, kappa) square; units as in the module
+    docstring (angles rad, torques as fractions of the gear, reflex in activation per m and
+    per m/s)."""
+
+    k_ax: float = 0.0  # ankle balance reflex: activation per m of COM ahead of the support
+    k_av: float = 0.0  # ... per m/s of COM velocity
+    kp_t: float = 1.069  # torso pitch through the support hips
+    kd_t: float = 0.4888
+    pitch_d: float = 0.185  # torso lean target (rad, forward)
+    theta0: float = 0.1523  # foot placement: thigh angle target (rad from vertical, forward)
+    c_v: float = 0.2233  # ... per m/s of COM speed
+    c_d: float = 0.4651  # ... per m of COM ahead of the support
+    kp_sw: float = 1.09  # hip gains of a leg placing its foot
+    kd_sw: float = 0.15
+    kf_t: float = 0.0  # in flight: hip torque from the torso pitch error (fraction)
+    knee_ext: float = -0.1806  # knee target in the extensor burst on the ground (push)
+    knee_crouch: float = -0.3  # knee target on the ground outside the burst
+    knee_swing: float = -0.9822  # knee target with full swing drive
+    knee_land: float = -0.1806  # knee target in the air without swing drive
+    kp_knee: float = 1.007  # knee stiffness on the ground outside the burst (gear per rad)
+    kp_push: float = 1.007  # ... on the ground in the burst (push)
+    kp_air: float = 1.007  # ... in the air and lifting
+    kd_knee: float = 0.1
+    push: float = 0.9162  # knee extension torque per unit of burst drive
+
 
 @dataclass(frozen=True)
 class ControlParams:
-    """Controller gains; angles in rad, torques as fractions of the motor gear."""
+    """The one controller's parameters: shared ones, and the blended gains at the four corners
+    of the (sigma, kappa) square (see the module docstring)."""
 
-    time_scale: float = 13.0  # CPG model units per second
-    v_half: float = 0.0  # activation map midpoint (cell voltage)
-    width: float = 0.04  # activation map slope (cell voltage)
-    pitch_d: float = 0.05  # torso lean target (rad, forward)
-    kp_t: float = 3.0
-    kd_t: float = 0.3
-    theta0: float = 0.35  # swing thigh angle target (rad from vertical, forward)
-    c_v: float = 0.15
-    c_d: float = 0.3
-    kp_sw: float = 2.0
-    kd_sw: float = 0.15
-    knee_swing: float = -1.0
-    knee_stance: float = -0.05
-    kp_knee: float = 2.0
-    kd_knee: float = 0.1
-    push: float = 0.3  # stance knee extension torque per unit extensor activation
-    ankle_gain: float = 1.0  # ankle muscle ctrl = ankle_gain * activation
-    swing_margin: float = 0.0  # alternating gaits: swing only when a_E < a_E(other) - margin
-    two_legged: bool = False  # jump/hop: both legs share stance and flight
-    # Two-legged gaits only (knee_stance/kp_knee: push-off; knee_swing: landing pose).
-    knee_crouch: float = -0.4  # knee target on the ground outside the push (rad)
-    kp_crouch: float = 1.0
-    kp_land: float = 1.0  # knee gain in the air
-    k_ax: float = 0.0  # ankle balance reflex: activation per m of COM ahead of the feet
-    k_av: float = 0.0  # ... per m/s of COM velocity
-    kf_t: float = 0.0  # in the air: hip torque from the torso pitch error (fraction)
-    contact_hold: float = 0.03  # s: ground contact held this long after the last touch
+    ankle_gain: float = 0.25  # ankle muscle ctrl = ankle_gain * CPG activation
+    e_on: float = 0.5  # extensor activation from which a leg is commanded to stance
+    w_flex: float = 1.0  # swing drive from the leg's own flexor
+    w_cross: float = 1.0  # swing drive from the other leg's extensor (crossed extension)
+    contact_hold: float = 0.0  # s: ground contact held this long after the last touch
+    alternating: Corner = Corner(
+        k_ax=6.75843, k_av=1.74423, kp_t=5.81779, kd_t=0.435745, pitch_d=0.257448,
+        theta0=0.377273, c_v=0.0428596, c_d=0.408213, kp_sw=1.47707, kd_sw=0.0568613,
+        kf_t=-0.768358, knee_ext=-0.369504, knee_crouch=-0.264224, knee_swing=-0.308863,
+        knee_land=-0.356837, kp_knee=1.65299, kp_push=0.862569, kp_air=3.36174,
+        kd_knee=0.0426775, push=0.241425)  # sigma = 0, kappa = 0
+    alternating_coactive: Corner = Corner(
+        k_ax=10.562, k_av=3.4941, kp_t=3.74667, kd_t=0.570752, pitch_d=0.0875772,
+        theta0=0.004821, c_v=0.406405, c_d=0.527345, kp_sw=1.35279, kd_sw=0.23361,
+        kf_t=0.0241645, knee_ext=-0.606263, knee_crouch=-0.473625, knee_swing=-0.975398,
+        knee_land=-0.624593, kp_knee=4.78708, kp_push=4.31312, kp_air=4.74115,
+        kd_knee=0.15244, push=0.811227)  # sigma = 0, kappa = 1
+    synchronous: Corner = Corner(
+        k_ax=15.405, k_av=1.65213, kp_t=3.79622, kd_t=0.499886, pitch_d=0.250948,
+        theta0=0.0418366, c_v=0.21664, c_d=0.16645, kp_sw=3.84253, kd_sw=0.0300601,
+        kf_t=-0.946302, knee_ext=-0.0502864, knee_crouch=-0.310951,
+        knee_swing=-0.394472, knee_land=-0.219799, kp_knee=2.21419, kp_push=4.89344,
+        kp_air=2.43328, kd_knee=0.0536399, push=0.20081)  # sigma = 1, kappa = 0
+    synchronous_coactive: Corner = Corner(
+        k_ax=0.592679, k_av=4.5132, kp_t=4.11062, kd_t=0.258228, pitch_d=0.197643,
+        theta0=0.340126, c_v=0.211234, c_d=0.268493, kp_sw=3.13671, kd_sw=0.382845,
+        kf_t=-0.195603, knee_ext=-0.31993, knee_crouch=-0.472452, knee_swing=-0.634746,
+        knee_land=-0.159711, kp_knee=0.536043, kp_push=4.992, kp_air=3.6832,
+        kd_knee=0.0525718, push=0.793964)  # sigma = 1, kappa = 1
+
+    def corner(self, name: str) -> Corner:
+        return getattr(self, name)
+
+    def with_corner(self, name: str, **gains) -> "ControlParams":
+        return replace(self, **{name: replace(self.corner(name), **gains)})
 
 
-if tuple(f.name for f in fields(ControlParams)) != kernel.PARAM_NAMES:
-    raise ImportError("ControlParams and envs.control_kernel.PARAM_NAMES disagree")
+if tuple(f.name for f in fields(Corner)) != kernel.BLENDED or tuple(
+        f.name for f in fields(ControlParams))[:kernel.N_SHARED] != kernel.SHARED or tuple(
+        f.name for f in fields(ControlParams))[kernel.N_SHARED:] != kernel.CORNERS:
+    raise ImportError("ControlParams and envs.control_kernel's parameter layout disagree")
 
-
-# Presets: the paper's (I_app, phi, w_a, w_b, w_c) from Table 2 with controller settings.
-GAIT_CONTROL = {
-    # Tuned with scripts/tune_controller.py (pymoo GA, fitness from the acceptance criteria,
-    # averaged over several conditions: see README "Status of the physical gaits").
-    # walk: a GA from a random population (pop 60, 60 generations, seed 7, conditions table3,
-    # seed:10, seed:11, friction:0.7), then refined (--start, 30 generations) with friction
-    # x0.5 and x2.0 added; the earlier walk started at double cadence for 2-10 s.
-    "walk": ControlParams(ankle_gain=0.5053, push=0.9162, theta0=0.1523, c_v=0.2233,
-                          c_d=0.4651, kp_t=1.069, kd_t=0.4888, knee_swing=-0.9822,
-                          time_scale=15.61, pitch_d=0.185, kp_sw=1.09, kp_knee=1.007,
-                          swing_margin=0.03528, knee_stance=-0.1806),
-    # run: a GA from a random population (pop 60, 50 generations, seed 11, --min-speed 0.9,
-    # conditions table3, seed:10, seed:11, friction:0.7); the earlier run, refined from a
-    # preset, stuttered.
-    "run": ControlParams(ankle_gain=0.8896, push=0.9195, theta0=0.3554, c_v=0.133,
-                         c_d=0.03464, kp_t=2.462, kd_t=0.2521, knee_swing=-1.308,
-                         time_scale=13.85, pitch_d=0.1223, kp_sw=0.9199, kp_knee=2.608,
-                         swing_margin=0.4501, knee_stance=-0.8303),
-    "jump": ControlParams(two_legged=True, knee_crouch=-0.3704, kp_crouch=1.7187,
-                          knee_stance=-0.2535, push=0.2307, kp_knee=0.5514, knee_swing=-0.6535,
-                          kp_land=0.8493, theta0=0.2143, c_v=0.1755, kp_sw=1.1772, kd_sw=0.3807,
-                          kp_t=5.9007, kd_t=0.1074, pitch_d=0.2077, ankle_gain=0.0722,
-                          k_ax=28.4328, k_av=4.9962, time_scale=19.584, kf_t=-0.621,
-                          contact_hold=0.0465, c_d=0.0),
-    "hop": ControlParams(two_legged=True, knee_crouch=-0.4997, kp_crouch=1.468,
-                         knee_stance=-0.08118, push=0.874, kp_knee=3.808, knee_swing=-0.4114,
-                         kp_land=3.711, theta0=0.1107, c_v=0.09242, c_d=0.0242, kp_sw=1.463,
-                         kd_sw=0.3824, kp_t=3.923, kd_t=0.319, pitch_d=0.2249, ankle_gain=0.02124,
-                         k_ax=5.576, k_av=1.897, time_scale=19.41, kf_t=0.1534,
-                         contact_hold=0.05336),
-}
+# The one parameter set, for every gait and every network.
+CONTROL = ControlParams()
 
 
 @dataclass
 class CPGSchedule:
-    """CPG outputs sampled on a fixed grid of model time, integrated once ahead."""
+    """A network's outputs v and activations a (T, 4), LF, RF, LE, RE, on a grid of dt_s
+    seconds from t = 0 (the moment the body starts)."""
 
-    t_model: np.ndarray  # (T,)
-    v: np.ndarray  # (T, 4)
-    dt_model: float
+    v: np.ndarray
+    a: np.ndarray
+    dt_s: float
+    network: Network
 
-
-def cpg_schedule(i_app: float, phi: float, W: np.ndarray, y0: np.ndarray, t_model_end: float,
-                 dt: float = 0.02, settle: float = 200.0) -> CPGSchedule:
-    """Integrate the network ahead: ``settle`` model units of transient, then the rollout."""
-    tr = simulate_ml(i_app, phi, W, y0, t_end=settle + t_model_end + 1.0, dt=dt, t_record=settle)
-    if tr.diverged[0]:
-        raise InputError("the CPG diverges for these weights (state left the cell's range)")
-    return CPGSchedule(tr.t - settle, np.ascontiguousarray(tr.x[0], dtype=float), dt)
+    @property
+    def t_s(self) -> np.ndarray:
+        return np.arange(len(self.v)) * self.dt_s
 
 
-def activation(v: np.ndarray, p: ControlParams) -> np.ndarray:
-    return 1.0 / (1.0 + np.exp(-(np.asarray(v) - p.v_half) / p.width))
+def cpg_schedule(network: Network, seconds: float, *, to: Network | None = None,
+                 change: Schedule | None = None) -> CPGSchedule:
+    """Integrate ``network`` from its initial state for ``seconds`` (plus a margin), in its own
+    time unit; optionally moving its parameters towards ``to`` along ``change`` (knot times in
+    seconds)."""
+    u = network.units_per_s
+    every = max(1, int(round(0.002 * u / network.dt)))  # a sample at least every ~2 ms
+    sched = None if change is None else change.scaled(u)
+    out = network.outputs((seconds + 0.1) * u, record_every=every, to=to, schedule=sched)
+    if out.diverged:
+        raise InputError(f"the {network.kind} network diverges (its state leaves the cell's "
+                         f"range): it cannot drive the body")
+    v = np.ascontiguousarray(out.v, dtype=float)
+    return CPGSchedule(v, np.ascontiguousarray(network.activation(v)), network.dt * every / u,
+                       network)
 
 
 def params_array(p: ControlParams) -> np.ndarray:
-    """The parameters as the float array the compiled kernel unpacks."""
-    return np.array([float(getattr(p, n)) for n in kernel.PARAM_NAMES])
+    """The parameters as the float array the compiled kernel unpacks (layout in
+    :mod:`envs.control_kernel`)."""
+    out = [float(getattr(p, n)) for n in kernel.SHARED]
+    for g in kernel.BLENDED:
+        out += [float(getattr(p.corner(c), g)) for c in kernel.CORNERS]
+    return np.array(out)
+
+
+def without_ankle_drive(p: ControlParams) -> ControlParams:
+    """The same controller with the CPG's ankle drive removed (the reflex stays)."""
+    return replace(p, ankle_gain=0.0)
 
 
 def kernel_index(m) -> np.ndarray:
     """Addresses in MjData that the kernel reads (layout ``kernel.IX_*``); m: mujoco.MjModel."""
-    jq = lambda n: m.jnt_qposadr[m.joint(n).id]  # noqa: E731
-    jv = lambda n: m.jnt_dofadr[m.joint(n).id]  # noqa: E731
-    sa = lambda n: m.sensor_adr[m.sensor(n).id]  # noqa: E731
+    def named(kind, name):
+        try:
+            return getattr(m, kind)(name)
+        except KeyError:
+            raise InputError(f"the model has no {kind} named {name!r}, which the controller "
+                             f"needs") from None
+
+    jq = lambda n: m.jnt_qposadr[named("joint", n).id]  # noqa: E731
+    jv = lambda n: m.jnt_dofadr[named("joint", n).id]  # noqa: E731
+    sa = lambda n: m.sensor_adr[named("sensor", n).id]  # noqa: E731
     body_floor = [sa(f"{b}_floor") for b in BODY_FLOOR_SENSORS]
     if body_floor != list(range(body_floor[0], body_floor[0] + len(body_floor))):
         raise InputError("the body-floor contact sensors must be consecutive in the MJCF")
@@ -165,12 +231,12 @@ def kernel_index(m) -> np.ndarray:
         ix[kernel.IX_HIP_Q + i], ix[kernel.IX_HIP_V + i] = jq(f"{leg}_hip"), jv(f"{leg}_hip")
         ix[kernel.IX_KNEE_Q + i], ix[kernel.IX_KNEE_V + i] = jq(f"{leg}_knee"), jv(f"{leg}_knee")
         ix[kernel.IX_FORCE + i] = sa(f"{leg}_foot_contact") + 3  # found, then force x y z: normal
-        ix[kernel.IX_FOOT + i] = m.body(f"{leg}_foot").id
+        ix[kernel.IX_FOOT + i] = named("body", f"{leg}_foot").id
         for j, name in enumerate(("hip", "knee", "ankle")):
             ix[kernel.IX_JOINTS + 3 * i + j] = jq(f"{leg}_{name}")
     ix[kernel.IX_ROOTY_Q], ix[kernel.IX_ROOTY_V] = jq("rooty"), jv("rooty")
     ix[kernel.IX_COM], ix[kernel.IX_COMVEL] = sa("com_pos"), sa("com_vel")
-    ix[kernel.IX_TORSO] = m.body("torso").id
+    ix[kernel.IX_TORSO] = named("body", "torso").id
     ix[kernel.IX_BODY_FLOOR], ix[kernel.IX_N_BODY_FLOOR] = body_floor[0], len(body_floor)
     return ix
 
@@ -187,11 +253,9 @@ class CPGController:
     ``mujoco.MjModel`` / ``mujoco.MjData`` (a dm_control Physics' ``model.ptr``, ``data.ptr``).
     """
 
-    def __init__(self, model, data, schedule: CPGSchedule, params: ControlParams,
-                 t_model0: float = 0.0):
+    def __init__(self, model, data, schedule: CPGSchedule, params: ControlParams = CONTROL):
         self.p = params
         self.sched = schedule
-        self.t_model0 = float(t_model0)
         self.P = params_array(params)
         self.S = kernel.new_state()
         self.ix = kernel_index(model)
@@ -199,24 +263,16 @@ class CPGController:
         self.views = (d.qpos, d.qvel, d.sensordata, d.xpos)
         self.u = np.zeros(8)
         self.last_v = np.zeros(4)
-
-    def t_model(self, t_s: float) -> float:
-        return self.t_model0 + self.p.time_scale * t_s
+        self.last_a = np.zeros(4)
 
     @property
-    def stance(self) -> np.ndarray:
-        """(2,) bool: the legs the controller treats as stance legs."""
-        return self.S[kernel.S_STANCE:kernel.S_STANCE + 2] > 0.5
+    def modes(self) -> np.ndarray:
+        """(2,) leg modes (kernel.MODE_SUPPORT, MODE_LIFT, MODE_AIR) of the last tick."""
+        return self.S[kernel.S_MODE:kernel.S_MODE + 2].copy()
 
     def __call__(self, t_s: float) -> np.ndarray:
         """The 8 controls at time t_s (s): LF, RF, LE, RE muscles, then hip and knee torques."""
         qpos, qvel, sens, xpos = self.views
-        kernel.control(t_s, self.t_model0, self.sched.v, self.sched.dt_model, self.P, self.S, qpos,
-                       qvel, sens, xpos, self.ix, self.u, self.last_v)
+        kernel.control(t_s, self.sched.v, self.sched.a, self.sched.dt_s, self.P, self.S, qpos,
+                       qvel, sens, xpos, self.ix, self.u, self.last_v, self.last_a)
         return self.u
-
-
-def preset_network(gait: str):
-    """(I_app, phi, W, y0) of a Table 2 preset."""
-    pr = ml.preset(gait)
-    return pr.i_app, pr.phi, ml.weight_matrix(pr.weights), pr.y0

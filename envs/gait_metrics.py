@@ -16,13 +16,9 @@ Definitions (over the analysis window, after the settling period):
 - distance, mean speed: centre-of-mass x travelled and divided by the window length;
 - footfalls per stride of a foot: its touchdowns x stride period / window length (1 when every
   stride has one touchdown of that foot).
-Physical gait (from these numbers alone):
-- "none" when fallen, or fewer than 3 touchdowns per foot;
-- two-legged (|lag| within ``SYNC_TOL`` of 0 or 1) with flight >= 10%: "hop" when the mean
-  duty factor is below ``HOP_DUTY``, else "jump";
-- alternating (lag within 0.5 +- ``ALT_TOL``): "walk" when flight < 2%, double support > 5%
-  and duty >= 0.5 on both feet; "run" when flight >= 10% and duty < 0.5 on both feet;
-- otherwise "none".
+Physical gait (from these numbers alone): "none" when fallen, or with fewer than 3 touchdowns
+per foot; otherwise the first gait of :data:`envs.criteria.CRITERIA` whose pattern (lag, duty,
+double support, flight) the numbers meet, else "none".
 """
 from __future__ import annotations
 
@@ -32,9 +28,6 @@ import numpy as np
 from numba import njit
 
 MIN_PHASE_S = 0.03
-SYNC_TOL = 0.1
-ALT_TOL = 0.15
-HOP_DUTY = 0.45
 
 
 def debounce(contact: np.ndarray, dt: float, min_phase_s: float = MIN_PHASE_S) -> np.ndarray:
@@ -119,21 +112,15 @@ def lr_lag(td_left: np.ndarray, td_right: np.ndarray, period: float) -> float:
 
 
 def classify_physical(m: GaitMetrics) -> str:
+    from .criteria import CRITERIA
+
     if m.fell or min(len(m.touchdowns["left"]), len(m.touchdowns["right"])) < 3:
         return "none"
-    lag = m.lr_phase_lag
-    if not np.isfinite(lag):
+    if not np.isfinite(m.lr_phase_lag):
         return "none"
-    duty = np.array([m.duty_factor["left"], m.duty_factor["right"]])
-    if min(lag, 1.0 - lag) <= SYNC_TOL:
-        if m.flight >= 0.10:
-            return "hop" if duty.mean() < HOP_DUTY else "jump"
-        return "none"
-    if abs(lag - 0.5) <= ALT_TOL:
-        if m.flight < 0.02 and m.double_support > 0.05 and np.all(duty >= 0.5):
-            return "walk"
-        if m.flight >= 0.10 and np.all(duty < 0.5):
-            return "run"
+    for name, c in CRITERIA.items():
+        if not c.pattern_failures(m):
+            return name
     return "none"
 
 
@@ -174,3 +161,112 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
                               else float("nan") for k, v in td.items()})
     m.physical_gait = classify_physical(m)
     return m
+
+
+# ------------------------------------------------------------------ biomechanics
+G = 9.81  # m/s^2
+IN_PLACE_MPS = 0.1  # below this mean speed a gait is "in place": work per stride, not CoT
+
+
+@dataclass
+class Biomechanics:
+    """The numbers a locomotion researcher quotes first (window after the settling period).
+
+    froude                  v^2 / (g L), v the mean forward speed, L the standing hip height
+    stride_length_m         |v| x stride period (one stride = one cycle of one foot)
+    relative_stride_length  stride length / L
+    positive_work_J         sum over actuators and ticks of max(tau omega, 0) dt
+    cost_of_transport       positive work / (m g |distance|); None for a gait in place
+                            (|v| < IN_PLACE_MPS), whose work_per_stride_J is reported instead
+    work_per_stride_J       positive work / number of strides
+    apex_height_m           median over flight phases of the rise of the centre of mass
+                            (highest point in the flight minus its height at take-off); 0
+                            without flight
+    stride_cv               standard deviation / mean of the stride periods (touchdown to
+                            touchdown of the same foot, both feet pooled)
+    period2_index           |mean of even strides - mean of odd strides| / mean stride, per foot,
+                            the larger of the two: 0 for a regular gait, large when long and
+                            short strides alternate (a period-2 bounce)
+    stance_work_share       fraction of the positive work done in stance (a leg's work while
+                            its foot is on the ground) at the hip, knee and ankle
+    """
+
+    froude: float
+    stride_length_m: float
+    relative_stride_length: float
+    positive_work_J: float
+    cost_of_transport: float | None
+    work_per_stride_J: float
+    apex_height_m: float
+    stride_cv: float
+    period2_index: float
+    stance_work_share: dict
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, end) index pairs of the True runs of a boolean series."""
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    d = np.diff(m.astype(np.int8))
+    return list(zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0]))
+
+
+def apex_height(com_z: np.ndarray, flight: np.ndarray) -> float:
+    rises = [float(com_z[a:b].max() - com_z[a]) for a, b in runs(flight) if b - a >= 2]
+    return float(np.median(rises)) if rises else 0.0
+
+
+def stride_regularity(touchdowns: dict) -> tuple[float, float]:
+    """(stride_cv, period2_index) from each foot's touchdown times (s)."""
+    periods = [np.diff(np.asarray(td, float)) for td in touchdowns.values()]
+    pooled = np.concatenate(periods) if periods else np.empty(0)
+    cv = float(np.std(pooled) / np.mean(pooled)) if len(pooled) >= 2 else float("nan")
+    p2 = []
+    for d in periods:
+        if len(d) >= 4:
+            p2.append(abs(d[0::2].mean() - d[1::2].mean()) / d.mean())
+    return cv, (float(max(p2)) if p2 else float("nan"))
+
+
+def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: np.ndarray,
+                 power: np.ndarray, leg_joint: np.ndarray, leg_of: np.ndarray, m: GaitMetrics,
+                 leg_length_m: float, mass_kg: float, settle_s: float = 0.0,
+                 min_phase_s: float = MIN_PHASE_S) -> Biomechanics:
+    """Biomechanics of a rollout (see :class:`Biomechanics`).
+
+    power (T, n_act) W per actuator; leg_joint (n_act,) in {"hip", "knee", "ankle"} and
+    leg_of (n_act,) in {0 (left), 1 (right)}: where each actuator acts. ``m``: the contact
+    metrics of the same window (stride period, touchdowns, speed)."""
+    t = np.asarray(t, float)
+    sel = t >= settle_s
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    v = float(m.speed_mps)
+    period = float(m.stride_period_s)
+    stride = abs(v) * period if np.isfinite(period) else float("nan")
+    cs = np.stack([debounce(contact[:, i], dt, min_phase_s) for i in range(2)], axis=1)[sel]
+    p = np.asarray(power, float)[sel]
+    pos = np.maximum(p, 0.0)
+    work = float(pos.sum() * dt)
+    n_strides = (float(t[sel][-1] - t[sel][0]) / period
+                 if sel.sum() > 1 and np.isfinite(period) and period > 0 else float("nan"))
+    dist = abs(float(m.distance_m))
+    cot = (work / (mass_kg * G * dist)) if abs(v) >= IN_PLACE_MPS and dist > 0 else None
+    flight = ~cs.any(axis=1)
+    stance_work = {}
+    for j in ("hip", "knee", "ankle"):
+        w = 0.0
+        for a in np.nonzero(np.asarray(leg_joint) == j)[0]:
+            w += float(pos[cs[:, int(leg_of[a])], a].sum() * dt)
+        stance_work[j] = w
+    total = sum(stance_work.values())
+    cv, p2 = stride_regularity(m.touchdowns)
+    return Biomechanics(
+        froude=v * v / (G * leg_length_m), stride_length_m=stride,
+        relative_stride_length=stride / leg_length_m, positive_work_J=work,
+        cost_of_transport=cot, work_per_stride_J=work / n_strides if n_strides > 0 else float("nan"),
+        apex_height_m=apex_height(np.asarray(com_z, float)[sel], flight), stride_cv=cv,
+        period2_index=p2,
+        stance_work_share={j: (w / total if total > 0 else float("nan"))
+                           for j, w in stance_work.items()})

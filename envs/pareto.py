@@ -4,26 +4,53 @@ from __future__ import annotations
 import csv
 import io as _io
 import os
+import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from cpg.errors import InputError
-from cpg.io import ensure_dir, to_json, write_json, write_text
-from cpg.search import load_result
+from cpg.io import to_json, write_json, write_text
+from cpg.outdir import ResultDir
+from cpg.results import load_result
 
 
 def _one(args):
-    gait, k, weights, seconds, render_dir = args
+    gait, k, weights, i_app, phi, seconds, render_dir = args
+    from cpg.network import build
     from envs.validate import validate
 
-    v = validate(gait, weights, seconds, record_qpos=render_dir is not None)
+    net = build("ml", gait, weights=weights, i_app=i_app, phi=phi)
+    v = validate(net, gait, seconds, stop_on_fall=render_dir is None)
     video = None
     if render_dir is not None:
         from envs.render import render_video
 
-        video = str(render_video(v.recording, Path(render_dir) / f"point_{k:03d}.mp4",
-                                 seconds=min(seconds, 8.0), width=480, height=360))
+        video = f"point_{k:03d}.mp4"  # beside pareto_check.json
+        render_video(v.recording, Path(render_dir) / video, seconds=min(seconds, 8.0), width=480,
+                     height=360)
     return k, v.summary(), video, (v.recording, v.metrics)
+
+
+def _pool_map(fn, jobs, workers: int, progress: bool, desc: str):
+    """fn over jobs in worker processes, in order, with a progress bar. On Ctrl-C the pending
+    jobs are cancelled and the workers terminated at once (no wait for running rollouts)."""
+    from tqdm import tqdm
+
+    # spawn: forking a parent that already runs OpenMP threads aborts the child
+    ex = ProcessPoolExecutor(min(workers, len(jobs)),
+                             mp_context=multiprocessing.get_context("spawn"))
+    try:
+        futures = [ex.submit(fn, j) for j in jobs]
+        out = []
+        for f in tqdm(futures, total=len(jobs), disable=not progress, desc=desc, unit="point"):
+            out.append(f.result())
+        ex.shutdown()
+        return out
+    except BaseException:
+        for proc in list(getattr(ex, "_processes", {}).values()):
+            proc.terminate()
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
 
 
 def check_pareto(result: str, out: str, first: int | None = None, seconds: float = 20.0,
@@ -34,20 +61,24 @@ def check_pareto(result: str, out: str, first: int | None = None, seconds: float
         raise InputError(f"--first must be at least 1, got {first}")
     if workers < 1:
         raise InputError(f"--workers must be at least 1, got {workers}")
-    out = ensure_dir(out)
     if rrd is not None and not str(rrd).endswith(".rrd"):
         raise InputError(f"--rrd must name an .rrd file, got {rrd!r}")
     points = data["pareto"][:first] if first else data["pareto"]
+    if not points:
+        raise InputError(f"{result!r} holds no Pareto points to check")
     gait = data["gait"]
-    jobs = [(gait, k, p["weights"], seconds, str(out) if render else None)
-            for k, p in enumerate(points)]
-    from tqdm import tqdm
+    with ResultDir(out) as rd:
+        jobs = [(gait, k, p["weights"], data["i_app"], data["phi"], seconds,
+                 str(rd.staging) if render else None) for k, p in enumerate(points)]
+        results = {k: (summary, video, rec) for k, summary, video, rec in
+                   _pool_map(_one, jobs, workers, progress, f"physics check {gait}")}
+        report = _write(rd, result, gait, points, seconds, results, rrd)
+        rd.commit()
+    return report
 
-    results = {}
-    with ProcessPoolExecutor(min(workers, len(jobs))) as ex:
-        for k, summary, video, rec in tqdm(ex.map(_one, jobs), total=len(jobs), disable=not progress,
-                                           desc=f"physics check {gait}", unit="point"):
-            results[k] = (summary, video, rec)
+
+def _write(rd, result, gait, points, seconds, results, rrd) -> dict:
+    """Write the table, CSV and JSON into the staging folder; the report."""
     rows = []
     for k, p in enumerate(points):
         s, video, _ = results[k]
@@ -82,7 +113,7 @@ def check_pareto(result: str, out: str, first: int | None = None, seconds: float
         from envs.record import write_rrd
 
         write_rrd(rrd, {f"point_{k:03d}": results[k][2] for k in sorted(results)})
-    write_text(out / "pareto_check.md", markdown)
-    write_text(out / "pareto_check.csv", buf.getvalue())
-    write_json(out / "pareto_check.json", {"result": str(result), "gait": gait, "points": rows})
+    write_text(rd.path("pareto_check.md"), markdown)
+    write_text(rd.path("pareto_check.csv"), buf.getvalue())
+    write_json(rd.path("pareto_check.json"), {"result": str(result), "gait": gait, "points": rows})
     return {"markdown": markdown, "rows": rows, "json": to_json(rows)}

@@ -50,16 +50,39 @@ def _ffmpeg():
     return mediapy
 
 
+MAX_FPS = 240.0  # frames per simulated second
+
+
+def offscreen_size(xml_path=None) -> tuple[int, int]:
+    """(width, height) of the model's off-screen buffer (<visual><global offwidth offheight>)."""
+    from models import BIPED_SCENE
+
+    from .biped import load_model
+
+    g = load_model(xml_path or BIPED_SCENE).vis.global_
+    return int(g.offwidth), int(g.offheight)
+
+
 def check_video_size(width: int, height: int, fps: float, seconds: float) -> None:
+    """Every size-like input of a video, before any work: positive, even, within the model's
+    off-screen buffer; fps in (0, MAX_FPS]; seconds in (0, MAX_SECONDS]."""
+    from .rollout import MAX_SECONDS
+
     if width <= 0 or height <= 0:
         raise InputError(f"video size must be positive, got {width}x{height}")
+    max_w, max_h = offscreen_size()
+    if width > max_w or height > max_h:
+        raise InputError(f"video size {width}x{height} exceeds the model's off-screen buffer "
+                         f"{max_w}x{max_h}")
     if width % 2 or height % 2:
         raise InputError(f"video size {width}x{height} is odd: yuv420p video needs even width "
                          f"and height")
-    if not (np.isfinite(fps) and fps > 0):
-        raise InputError(f"fps must be positive, got {fps}")
-    if not (np.isfinite(seconds) and seconds > 0):
-        raise InputError(f"seconds must be positive, got {seconds}")
+    if not (np.isfinite(fps) and 0 < fps <= MAX_FPS):
+        raise InputError(f"fps must be a number in (0, {MAX_FPS:g}], got {fps}")
+    if not (np.isfinite(seconds) and 0 < seconds <= MAX_SECONDS):
+        raise InputError(f"seconds must be a number in (0, {MAX_SECONDS:g}], got {seconds}")
+    if int(round(seconds * fps)) < 1:
+        raise InputError(f"{seconds:g} s at {fps:g} fps is less than one frame")
 
 
 _MARKER_OFFSET = np.array([0.05, -0.06, -0.05])  # m: beside the foot, toward the camera
@@ -81,8 +104,6 @@ class FrameRenderer:
         self.mujoco = mujoco
         check_backend()
         self.model = mujoco.MjModel.from_xml_path(str(xml_path or BIPED_SCENE))
-        self.model.vis.global_.offwidth = max(self.model.vis.global_.offwidth, width)
-        self.model.vis.global_.offheight = max(self.model.vis.global_.offheight, height)
         self.data = mujoco.MjData(self.model)
         self.renderer = mujoco.Renderer(self.model, height, width)
         self.cam = mujoco.MjvCamera()
@@ -153,23 +174,25 @@ def _signal_strip(rec, k: int, width: int, height: int) -> np.ndarray:
 
 def render_video(rec, path: str | Path, fps: float = 30.0, width: int = 640, height: int = 480,
                  seconds: float | None = None, signals: bool = True, fancy: bool = False) -> Path:
-    """Write an mp4 of a recording with qpos (``rollout(..., record_qpos=True)``)."""
+    """Write an mp4 of a recording (its joint positions), streamed
+    frame by frame to a temporary file that is renamed when complete."""
     seconds = float(rec.t[-1]) if seconds is None else seconds
     check_video_size(width, height, fps, seconds)
     if rec.qpos.size == 0:
-        raise InputError("the recording holds no states to render (record_qpos=False)")
+        raise InputError("the recording holds no states to render")
     idx = frame_indices(rec.t - rec.t[0] + rec.dt, fps, seconds)
     strip_h = (height // 5) & ~1 if signals else 0
     mediapy = _ffmpeg()
-    with FrameRenderer(width, height - strip_h, fancy) as fr:
-        frames = []
+    # Frames go to the encoder one by one (mediapy's VideoWriter pipes them to ffmpeg): memory
+    # does not grow with the video's length.
+    with FrameRenderer(width, height - strip_h, fancy) as fr, \
+            atomic_path(path, suffix=".mp4") as tmp, \
+            mediapy.VideoWriter(str(tmp), (height, width), fps=fps, codec="h264") as writer:
         for k in idx:
             f = fr.frame(rec.qpos[k], rec.contact[k])
             if signals:
                 f = np.concatenate([f, _signal_strip(rec, k, width, strip_h)], axis=0)
-            frames.append(f)
-    with atomic_path(path, suffix=".mp4") as tmp:
-        mediapy.write_video(str(tmp), frames, fps=fps, codec="h264")
+            writer.add_image(f)
     return Path(path)
 
 
@@ -223,6 +246,59 @@ def signals_picture(rec, path: str | Path, title: str = "") -> Path:
     for ax in axes:
         ax.legend(loc="upper right", fontsize=7, ncol=6, frameon=False)
     axes[0].set_title(title, fontsize=10, loc="left")
+    fig.tight_layout()
+    with atomic_path(path, suffix=".png") as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+    return Path(path)
+
+
+def gait_cycle(rec, touchdowns, leg: int, signals: np.ndarray, points: int = 101):
+    """Signals (T, k) of one leg resampled over each of its strides (touchdown to touchdown)
+    onto 0..100% of the cycle: (n_strides, points, k)."""
+    td = np.asarray(touchdowns, float)
+    out = []
+    pct = np.linspace(0.0, 1.0, points)
+    for a, b in zip(td[:-1], td[1:]):
+        grid = a + pct * (b - a)
+        out.append(np.stack([np.interp(grid, rec.t, signals[:, j])
+                             for j in range(signals.shape[1])], axis=1))
+    return np.array(out).reshape(len(out), points, signals.shape[1])
+
+
+def gait_cycle_picture(rec, metrics, path: str | Path, title: str = "",
+                       weight_n: float | None = None) -> Path:
+    """Hip, knee and ankle angles (deg) and the vertical ground reaction force (body weights)
+    of each leg against 0-100% of its gait cycle (touchdown to touchdown), mean +- s.d. over
+    the strides of the measured window; the biomechanics convention (SCONE's gait analysis)."""
+    from cpg.plots import _plt
+
+    from .biped import body_constants
+
+    plt = _plt()
+    if weight_n is None:
+        weight_n = body_constants(rec.xml_path)[1] * 9.81
+    fig, axes = plt.subplots(1, 4, figsize=(13, 3.2))
+    pct = np.linspace(0, 100, 101)
+    names = ("hip (deg)", "knee (deg)", "ankle (deg)", "vertical GRF (body weights)")
+    for leg, (name, color) in enumerate((("left", "tab:blue"), ("right", "tab:orange"))):
+        td = metrics.touchdowns[name]
+        if len(td) < 3:
+            continue
+        sig = np.concatenate([np.degrees(rec.joints[:, 3 * leg:3 * leg + 3]),
+                              rec.force[:, leg:leg + 1] / weight_n], axis=1)
+        cyc = gait_cycle(rec, td, leg, sig)
+        mean, sd = cyc.mean(axis=0), cyc.std(axis=0)
+        for j, ax in enumerate(axes):
+            ax.plot(pct, mean[:, j], color=color, lw=1.5, label=f"{name} (n={len(cyc)})")
+            ax.fill_between(pct, mean[:, j] - sd[:, j], mean[:, j] + sd[:, j], color=color,
+                            alpha=0.25, lw=0)
+    for ax, n in zip(axes, names):
+        ax.set_title(n, fontsize=9)
+        ax.set_xlabel("gait cycle (%)")
+        ax.set_xlim(0, 100)
+    axes[0].legend(fontsize=7, frameon=False)
+    fig.suptitle(title, fontsize=10, x=0.01, ha="left")
     fig.tight_layout()
     with atomic_path(path, suffix=".png") as tmp:
         fig.savefig(tmp, dpi=100, format="png")

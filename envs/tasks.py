@@ -1,8 +1,10 @@
 """dm_control tasks: the CPG drives the biped; an agent may add a residual to the controls.
 
-``envs.load(name, **options)`` mirrors ``suite.load``: tasks "walk", "run", "jump", "hop" use
-the paper's Table 2 network and the controller preset of that gait; "free" takes a weights
-file (optimiser result JSON) and a gait whose (I_app, phi) and controller preset it uses.
+``envs.load(name, **options)`` mirrors ``suite.load``: tasks "walk", "run", "jump", "hop" are
+driven by that preset of ``network`` (Morris-Lecar by default: the paper's Table 2), "free" by
+the Morris-Lecar weights of an optimiser result (JSON) with its I_app and phi. Every task uses
+the one controller (:data:`envs.controller.CONTROL`); the task's name sets only the reward's
+target speed.
 Action: 8 values in [-1, 1] added to the CPG controller's output (ankle muscles LF, RF, LE,
 RE then hips and knees) and clipped to the actuator ranges; a zero action is the pure CPG.
 Reward: upright (torso pitch within 0.3 rad, height above 0.7 m) times forward speed within
@@ -17,11 +19,11 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_control.utils import rewards
 
-from cpg import morris_lecar as ml
 from cpg.errors import InputError
+from cpg.network import Network, build
 
 from .biped import Physics, load_physics
-from .controller import GAIT_CONTROL, CPGController, ControlParams, cpg_schedule, preset_network
+from .controller import CONTROL, ControlParams, CPGController, cpg_schedule
 
 TARGET_SPEED = {"walk": 0.5, "run": 1.5, "jump": 0.3, "hop": 0.3}
 CONTROL_TIMESTEP = 0.004  # s: 2 physics steps of 2 ms, the control period the gains were tuned at
@@ -31,22 +33,24 @@ DEFAULT_TIME_LIMIT = 20.0  # s
 class CPGLocomotion(base.Task):
     """A primary gait driven by the 4-cell CPG; all randomness from ``random``."""
 
-    def __init__(self, gait: str, network, params: ControlParams, random=None,
-                 random_cpg_state: bool = False, friction_scale: float = 1.0):
+    def __init__(self, gait: str, network: Network, params: ControlParams = CONTROL,
+                 random=None, random_cpg_state: bool = False, friction_scale: float = 1.0,
+                 time_limit: float = DEFAULT_TIME_LIMIT):
         super().__init__(random=random)
         self.gait, self.network, self.params = gait, network, params
         self.random_cpg_state = random_cpg_state
         self.friction_scale = friction_scale
+        self.time_limit = time_limit
         self.controller: CPGController | None = None
 
     def initialize_episode(self, physics: Physics):
         if self.friction_scale != 1.0 and not getattr(physics, "_friction_scaled", False):
             physics.scale_friction(self.friction_scale)
             physics._friction_scaled = True
-        i_app, phi, W, y0 = self.network
+        net = self.network
         if self.random_cpg_state:
-            y0 = ml.random_states(1, self.random)[0]
-        sched = cpg_schedule(i_app, phi, W, y0, self.params.time_scale * 120.0)
+            net = net.with_state(net.random_state(self.random))
+        sched = cpg_schedule(net, self.time_limit + 1.0)
         self.controller = CPGController(physics.model.ptr, physics.data.ptr, sched, self.params)
         super().initialize_episode(physics)
 
@@ -81,29 +85,28 @@ class CPGLocomotion(base.Task):
         return float(upright * standing * (1 + 5 * move) / 6)
 
 
-def load(name: str, weights: str | None = None, gait: str | None = None,
+def load(name: str, weights: str | None = None, network: str = "ml", preset: str | None = None,
          time_limit: float = DEFAULT_TIME_LIMIT, random=None, random_cpg_state: bool = False,
          friction_scale: float = 1.0, xml_path=None) -> control.Environment:
     """An environment like ``suite.load``: walk, run, jump, hop, or free (with ``weights``)."""
     if name == "free":
         if weights is None:
             raise InputError("task 'free' needs a weights file (an optimiser result JSON)")
-        from cpg.search import load_result
+        from cpg.results import load_result
 
         data = load_result(weights)
-        gait = gait or data["gait"]
-        p = ml.preset(gait)
-        weights = data["chosen"]["weights"]
-        network = (p.i_app, p.phi, ml.weight_matrix(np.array(weights)), p.y0)
-    elif name in GAIT_CONTROL:
-        gait, weights = name, None
-        network = preset_network(name)
+        gait = data["gait"]
+        net = build("ml", preset or gait, weights=data["chosen"]["weights"], i_app=data["i_app"],
+                    phi=data["phi"])
+    elif name in TARGET_SPEED:
+        gait = name
+        net = build(network, preset or name)
     else:
         raise InputError(f"unknown task {name!r}: use walk, run, jump, hop or free")
+    if not (np.isfinite(time_limit) and time_limit > 0):
+        raise InputError(f"time_limit must be a positive number of seconds, got {time_limit}")
     physics = load_physics(xml_path) if xml_path else load_physics()
-    from .validate import control_for
-
-    task = CPGLocomotion(gait, network, control_for(gait, weights), random=random,
-                         random_cpg_state=random_cpg_state, friction_scale=friction_scale)
+    task = CPGLocomotion(gait, net, CONTROL, random=random, random_cpg_state=random_cpg_state,
+                         friction_scale=friction_scale, time_limit=time_limit)
     return control.Environment(physics, task, time_limit=time_limit,
                                control_timestep=CONTROL_TIMESTEP)

@@ -1,94 +1,101 @@
-"""Physical validation of a gait: one rollout, contact metrics, and both verdicts.
+"""Physical validation: one rollout, contact metrics, and both verdicts.
 
-``cpg_gait`` is what :func:`cpg.gaits.classify` names from the four CPG outputs recorded
-during the rollout; ``physical_gait`` is what :mod:`envs.gait_metrics` names from the foot
-contacts alone. A gait is physically real when the two agree and the body did not fall.
+A network (any kind, any preset or weights) drives the body through the one controller; the
+gait asked for (``gait``) is only the target the verdict checks. ``cpg_gait`` is what
+:func:`cpg.gaits.classify` names from the four CPG outputs recorded during the rollout;
+``physical_gait`` is what :mod:`envs.gait_metrics` names from the foot contacts alone. A gait
+passes when it meets every criterion of :data:`envs.criteria.CRITERIA` that one rollout can
+show (no fall, both classifiers agree with the target, its pattern and distance).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from cpg import morris_lecar as ml
 from cpg.errors import InputError
 from cpg.gaits import classify
+from cpg.integrate import Schedule
+from cpg.network import Network
 
-from .biped import Recording, rollout
-from .controller import GAIT_CONTROL
-from .gait_metrics import GaitMetrics, measure
-
-SETTLE_S = 2.0
+from .controller import CONTROL, ControlParams
+from .criteria import CRITERIA, SETTLE_S
+from .gait_metrics import Biomechanics, GaitMetrics, biomechanics, measure
+from .rollout import Recording, check_seconds, rollout
 
 
 @dataclass
 class Validation:
-    gait: str
+    network: Network
+    gait: str | None  # the target the verdict checks (None: no target)
     recording: Recording
     metrics: GaitMetrics
     cpg_gait: str
+    settle_s: float
+    ankle_drive: bool = True
+    biomech: Biomechanics | None = None
 
     def summary(self) -> dict:
         m = self.metrics
-        return {
-            "gait": self.gait, "fell": m.fell, "fell_at_s": m.fell_at_s,
+        s = {
+            "network": self.network.kind, "preset": self.network.preset, "gait": self.gait,
+            "ankle_drive": self.ankle_drive,
+            "settle_s": self.settle_s, "fell": m.fell, "fell_at_s": m.fell_at_s,
             "unstable": self.recording.unstable,
             "duty_factor": m.duty_factor, "lr_phase_lag": m.lr_phase_lag,
             "double_support": m.double_support, "flight": m.flight,
-            "stride_period_s": m.stride_period_s, "distance_m": m.distance_m,
-            "speed_mps": m.speed_mps, "footfalls_per_stride": m.footfalls_per_stride,
+            "stride_period_s": m.stride_period_s, "cpg_period_s": _cpg_period_s(self.network),
+            "distance_m": m.distance_m, "speed_mps": m.speed_mps,
+            "footfalls_per_stride": m.footfalls_per_stride,
             "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
-            "passed": bool(not m.fell and m.physical_gait == self.gait == self.cpg_gait),
         }
+        if self.biomech is not None:
+            s.update(self.biomech.as_dict())
+        s["failures"] = CRITERIA[self.gait].failures(s) if self.gait else []
+        s["passed"] = bool(self.gait and not s["failures"])
+        return s
 
 
-def network_for(gait: str, weights=None):
-    """(I_app, phi, W, y0): Table 2 for the gait, with optional (w_a, w_b, w_c) instead."""
-    if gait not in GAIT_CONTROL:
-        raise InputError(f"unknown gait {gait!r}: physical gaits are {', '.join(GAIT_CONTROL)}")
-    p = ml.preset(gait)
-    w = np.array(p.weights if weights is None else weights, dtype=float)
-    if w.shape != (3,):
-        raise InputError(f"weights must be three numbers (w_a, w_b, w_c), got shape {w.shape}")
-    return p.i_app, p.phi, ml.weight_matrix(w), p.y0
+def _cpg_period_s(net: Network) -> float | None:
+    try:
+        return net.period_s()
+    except InputError:
+        return None
 
 
-def cpg_period(gait: str, weights=None) -> float:
-    """Period (model units) of the gait's network, Table 2 or with (w_a, w_b, w_c) instead."""
-    from cpg.reproduce import run_preset
-
-    network_for(gait, weights)  # checks the gait and the weights' shape
-    res = run_preset(gait, weights=weights)
-    period = float("nan") if res.trajectory.diverged[0] else res.rhythm.period
-    if not (np.isfinite(period) and period > 0):
-        raise InputError(f"the {gait} network with weights {weights} does not oscillate")
-    return float(period)
+def check_gait(gait: str | None) -> str | None:
+    if gait is not None and gait not in CRITERIA:
+        raise InputError(f"unknown gait {gait!r}: physical gaits are {', '.join(CRITERIA)}")
+    return gait
 
 
-def control_for(gait: str, weights=None):
-    """The gait's controller preset. With other weights the time scale is rescaled so that one
-    CPG cycle lasts as long in seconds as with the paper's weights: the gains were tuned for
-    that stride, and the network's rhythm (phases, waveforms, one stride per cycle) is kept."""
-    p = GAIT_CONTROL[gait]
-    if weights is None or np.allclose(np.asarray(weights, dtype=float), ml.preset(gait).weights):
-        return p
-    return replace(p, time_scale=p.time_scale * cpg_period(gait, weights) / cpg_period(gait))
-
-
-def validate(gait: str, weights=None, seconds: float = 20.0, seed: int | None = None,
+def validate(network: Network, gait: str | None = None, seconds: float = 20.0, *,
              friction_scale: float = 1.0, push: tuple[float, float] | None = None,
-             settle_s: float = SETTLE_S, record_qpos: bool = False) -> Validation:
-    """Roll out ``seconds`` after ``settle_s`` of settling and measure the gait."""
-    if not (np.isfinite(seconds) and seconds > 0):
-        raise InputError(f"seconds must be a positive number, got {seconds}")
-    rec = rollout(network_for(gait, weights), control_for(gait, weights), seconds + settle_s,
-                  seed=seed, friction_scale=friction_scale, push=push, record_qpos=record_qpos,
-                  stop_on_fall=not record_qpos)
+             settle_s: float = SETTLE_S, stop_on_fall: bool = True, ankle_drive: bool = True,
+             params: ControlParams = CONTROL, to: Network | None = None,
+             change: Schedule | None = None) -> Validation:
+    """Roll out ``settle_s + seconds`` and measure the gait over the last ``seconds``."""
+    check_gait(gait)
+    seconds = check_seconds(seconds)
+    rec = rollout(network, seconds + settle_s, params, friction_scale=friction_scale, push=push,
+                  stop_on_fall=stop_on_fall, ankle_drive=ankle_drive, to=to, change=change)
+    return measure_recording(network, gait, rec, settle_s, ankle_drive)
+
+
+def measure_recording(network: Network, gait: str | None, rec: Recording, settle_s: float,
+                      ankle_drive: bool = True, t_end: float | None = None) -> Validation:
+    """Metrics and verdicts of a recording over [settle_s, t_end]."""
     fell_at = rec.fell_at if rec.unstable is None else (rec.t[-1] if len(rec.t) else 0.0)
-    m = measure(rec.t, rec.contact, rec.com_x, fell_at, settle_s=settle_s)
-    steady = rec.t >= settle_s
+    sel = rec.t <= (np.inf if t_end is None else t_end)
+    m = measure(rec.t[sel], rec.contact[sel], rec.com_x[sel], fell_at, settle_s=settle_s)
+    steady = sel & (rec.t >= settle_s)
     cpg_name = classify(rec.t[steady], rec.cpg_v[steady])[0] if steady.sum() > 16 else "none"
-    return Validation(gait, rec, m, cpg_name)
+    from .biped import body_constants
+
+    leg, mass, joint, side = body_constants(rec.xml_path)
+    bio = biomechanics(rec.t[sel], rec.contact[sel], rec.com_x[sel], rec.com_z[sel],
+                       rec.power[sel], joint, side, m, leg, mass, settle_s)
+    return Validation(network, gait, rec, m, cpg_name, settle_s, ankle_drive, bio)
 
 
 def metrics_table(summaries: dict[str, dict]) -> str:
@@ -98,9 +105,11 @@ def metrics_table(summaries: dict[str, dict]) -> str:
     rows = []
     for name, s in summaries.items():
         d = s["duty_factor"]
-        rows.append([name, "yes" if s["fell"] else "no", f"{d['left']:.2f}/{d['right']:.2f}",
-                     f"{s['lr_phase_lag']:.2f}", f"{s['double_support']:.2f}", f"{s['flight']:.2f}",
-                     f"{s['stride_period_s']:.2f}", f"{s['distance_m']:.2f}",
-                     s["physical_gait"], s["cpg_gait"], "PASS" if s["passed"] else "fail"])
+        f = lambda x, p=2: "nan" if x is None or not np.isfinite(x) else f"{x:.{p}f}"  # noqa: E731
+        verdict = "-" if not s.get("gait") else ("PASS" if s["passed"] else "fail")
+        rows.append([name, "yes" if s["fell"] else "no", f"{f(d['left'])}/{f(d['right'])}",
+                     f(s["lr_phase_lag"]), f(s["double_support"]), f(s["flight"]),
+                     f(s["stride_period_s"]), f(s["distance_m"]), s["physical_gait"],
+                     s["cpg_gait"], verdict])
     return format_table(rows, ["rollout", "fell", "duty L/R", "L-R lag", "double", "flight",
                                "stride s", "dist m", "physical", "cpg", "verdict"])

@@ -1,7 +1,7 @@
 """Benchmark: the physical biped, in one run (ratios against baselines measured here).
 
-1. Physics steps per second with the CPG and controller in the loop (``rollout``: the CPG is
-   integrated ahead in one batch, the controller runs every 2 physics steps) vs plain
+1. Physics steps per second with the CPG and the one controller in the loop (``rollout``: the
+   CPG is integrated ahead in one batch, the controller runs every 2 physics steps) vs plain
    ``mujoco.mj_step`` of the same model with zero control. Target ratio >= 0.5.
 2. Video frames per second of the renderer used by ``cpgbiped render`` vs a bare
    ``mujoco.Renderer`` loop over the same states with the same scene flags. Target >= 0.9x.
@@ -21,8 +21,8 @@ os.environ.setdefault("MUJOCO_GL", "osmesa")
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from envs.biped import rollout  # noqa: E402
-from envs.controller import GAIT_CONTROL, preset_network  # noqa: E402
+from cpg.network import build  # noqa: E402
+from envs.rollout import rollout  # noqa: E402
 from models import BIPED_SCENE  # noqa: E402
 
 
@@ -51,10 +51,10 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=20.0)
     ap.add_argument("--frames", type=int, default=150)
     a = ap.parse_args(argv)
-    net, p = preset_network("walk"), GAIT_CONTROL["walk"]
-    rollout(net, p, 0.5)  # warm up (kernel cache, imports)
+    net = build("ml", "walk")
+    rollout(net, 0.5)  # warm up (kernel cache, imports)
 
-    rec = rollout(net, p, a.seconds)
+    rec = rollout(net, a.seconds)
     n_steps = int(round(rec.t[-1] / rec.physics_dt))
     m = mujoco.MjModel.from_xml_path(str(BIPED_SCENE))
 
@@ -63,7 +63,7 @@ def main(argv=None) -> int:
         for _ in range(n_steps):
             mujoco.mj_step(m, d)
 
-    t_loop, t_plain, r_plain = paired(7, lambda: rollout(net, p, a.seconds), plain)
+    t_loop, t_plain, r_plain = paired(7, lambda: rollout(net, a.seconds), plain)
     print(f"1. physics, {n_steps} steps ({rec.t[-1]:.1f} s simulated, walk):")
     print(f"   CPG + controller in the loop : {n_steps / t_loop:10.0f} steps/s")
     print(f"   plain mj_step, zero control  : {n_steps / t_plain:10.0f} steps/s")
@@ -71,7 +71,7 @@ def main(argv=None) -> int:
 
     from envs.render import FrameRenderer
 
-    rec = rollout(net, p, 6.0, record_qpos=True)
+    rec = rollout(net, 6.0)
     idx = np.linspace(0, len(rec.t) - 1, a.frames).astype(int)
     fr = FrameRenderer(640, 480)
     fr.frame(rec.qpos[0], rec.contact[0])
@@ -106,7 +106,7 @@ def main(argv=None) -> int:
     from envs.record import write_rrd
 
     def without():
-        r_ = rollout(net, p, a.seconds)
+        r_ = rollout(net, a.seconds)
         return r_, measure(r_.t, r_.contact, r_.com_x, r_.fell_at, settle_s=2.0)
 
     with tempfile.TemporaryDirectory() as tmp:

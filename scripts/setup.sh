@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
-# Set up cpgbiped on a Debian machine with Python 3.11: the system libraries MuJoCo's
-# off-screen rendering and video writing need (OSMesa, ffmpeg; apt, as root), then the package
-# with its pinned dependencies (pip, editable). Safe to run again: it installs only what is missing.
+# Set up cpgbiped on a Debian machine with Python 3.11: the system packages MuJoCo's
+# off-screen rendering, video writing and the rerun web-viewer check need (OSMesa, ffmpeg,
+# chromium; apt, as root), then the package with its pinned dependencies (pip, editable).
+# Safe to run again: it installs only what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 need=()
 ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so' || need+=(libosmesa6)
 command -v ffmpeg >/dev/null 2>&1 || need+=(ffmpeg)
+# Debian's chromium: the rerun web-viewer check (scripts/check_rerun_viewer.py, its test)
+[[ -x /usr/bin/chromium ]] || need+=(chromium)
 if ((${#need[@]})); then
   if [[ $(id -u) == 0 ]] && command -v apt-get >/dev/null 2>&1; then
     echo "setup: apt-get install ${need[*]}"

@@ -8,6 +8,7 @@ import argparse
 import os
 import sys
 import textwrap
+import time
 
 # MuJoCo reads MUJOCO_GL when it is imported: set it once, before anything imports it.
 os.environ.setdefault("MUJOCO_GL", "osmesa")
@@ -32,7 +33,8 @@ examples:
   cpgbiped matsuoka                      what the printed 12-neuron network does, and the calibration
   cpgbiped hopf --gait walk              the Hopf network's version of a gait
 
-Outputs go under out/ unless told otherwise. Exit status: 0 ok, 2 bad input, 130 interrupted.
+Outputs go under out/ unless told otherwise. Exit status: 0 ok, 2 bad input, 1 internal
+error (one line; add --debug anywhere for the traceback), 130 interrupted.
 """
 
 
@@ -46,11 +48,95 @@ def _fail(msg: str) -> int:
     return 2
 
 
+# Argument types: checked while parsing, so a bad value costs nothing and argparse's one-line
+# error names the option the user typed ("argument --seed: ...").
+MAX_SECONDS = 600.0  # longest simulated rollout (envs.rollout.MAX_SECONDS; checked in a test)
+
+
+def _number(text: str, lo: float, hi: float, lo_open: bool, what: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{what}, got {text!r}") from None
+    if not (v == v and abs(v) != float("inf") and (v > lo if lo_open else v >= lo) and v <= hi):
+        raise argparse.ArgumentTypeError(f"{what}, got {text}")
+    return v
+
+
+def seconds_arg(text: str) -> float:
+    return _number(text, 0.0, MAX_SECONDS, True, f"must be a number of seconds in (0, "
+                                                   f"{MAX_SECONDS:g}]")
+
+
+def positive_arg(text: str) -> float:
+    return _number(text, 0.0, 1e6, True, "must be a positive finite number")
+
+
+def finite_arg(text: str) -> float:
+    return _number(text, -1e300, 1e300, False, "must be a finite number")
+
+
+def seed_arg(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text!r}") from None
+    if not 0 <= v < 2 ** 63:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer, got {text}")
+    return v
+
+
+def count_arg(lo: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer >= {lo}, got {text!r}") from None
+        if v < lo:
+            raise argparse.ArgumentTypeError(f"must be at least {lo}, got {v}")
+        return v
+    return parse
+
+
+def out_file(path: str | None, option: str, suffix: str) -> str | None:
+    """An output file the user named: the right extension, not a folder, and a destination
+    that can be written (checked before any work; nothing is created here)."""
+    if path is None:
+        return None
+    if not path.endswith(suffix):
+        raise _input_error(f"{option} must name a {suffix} file, got {path!r}")
+    if os.path.isdir(path):
+        raise _input_error(f"{option} names a folder, not a {suffix} file: {path!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    probe = folder
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    if not os.path.isdir(probe) or not os.access(probe, os.W_OK | os.X_OK):
+        raise _input_error(f"{option}: cannot write {path!r} ({probe!r} is not a writable "
+                           f"folder)")
+    return path
+
+
+def out_dir(path: str, option: str = "--out") -> str:
+    """An output folder the user named: not a file, under a writable folder."""
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise _input_error(f"{option} names a file, not a folder: {path!r}")
+    probe = os.path.abspath(path)
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    if not os.path.isdir(probe) or not os.access(probe, os.W_OK | os.X_OK):
+        raise _input_error(f"{option}: cannot write to {path!r} ({probe!r} is not a writable "
+                           f"folder)")
+    return path
+
+
 # ---------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(a) -> int:
     from cpg import io, morris_lecar as ml
     from cpg.reproduce import reproduce, table
 
+    if a.plot:
+        out_dir(a.out)
     results = reproduce(dt=a.dt)
     summary = {g: r.summary() for g, r in results.items()}
     if a.plot:
@@ -118,16 +204,37 @@ def cmd_hopf(a) -> int:
 
 
 # ----------------------------------------------------------------------------------- optimize
-def _progress(desc: str, total: int, enabled: bool = True):
-    from tqdm import tqdm
+class _progress:
+    """A tqdm bar on stderr that appears with the first finished generation (so that an error
+    found before any work stays the only line); (bar, callback) like a pair."""
 
-    bar = tqdm(total=total, desc=desc, unit="gen", leave=True, disable=not enabled,
-               file=sys.stderr)
+    def __init__(self, desc: str, total: int, enabled: bool = True):
+        self.desc, self.total, self.enabled, self.bar = desc, total, enabled, None
 
-    def on_generation(gen: int, n: int) -> None:
+    def __iter__(self):
+        return iter((self, self.on_generation))
+
+    def _ensure(self):
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=self.total, desc=self.desc, unit="gen", leave=True,
+                            disable=not self.enabled, file=sys.stderr)
+        return self.bar
+
+    def on_generation(self, gen: int, n: int) -> None:
+        bar = self._ensure()
         bar.update(gen - bar.n)
 
-    return bar, on_generation
+    def reset(self, total):
+        self._ensure().reset(total=total)
+
+    def set_description(self, text):
+        self._ensure().set_description(text)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
 
 
 def _evaluator(a):
@@ -141,30 +248,46 @@ def _evaluator(a):
 def cmd_optimize(a) -> int:
     from cpg.evaluate import SimSettings
     from cpg.optimize import RunSettings, check_bounds, primary_names
-    from cpg.search import comparison_markdown, optimize_primary
+    from cpg.outdir import ResultDir
+    from cpg.search import checkpoint_name, comparison_markdown, optimize_primary
     from cpg import io
 
+    out_dir(a.out)
     gaits_ = primary_names(a.gait)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     check_bounds(*a.bounds)
-    io.ensure_dir(a.out)
-    ev = _evaluator(a)
+    if a.robustness_objective < 0:
+        raise _input_error(f"--robustness-objective must be >= 0, got {a.robustness_objective}")
     results = {}
-    try:
-        for g in gaits_:
-            bar, cb = _progress(f"NSGA-II {g}", rs.gens, not a.quiet)
-            try:
-                results[g] = optimize_primary(g, rs, a.out, *a.bounds, SimSettings(), ev, cb,
-                                              robust_objective=a.robustness_objective,
-                                              lock_objective=a.lock_time_objective)
-            finally:
-                bar.close()
-    finally:
-        if ev is not None:
-            ev.close()
-    table = comparison_markdown(results, None)
-    if len(results) == 4:
-        io.write_text(os.path.join(a.out, "comparison.md"), table)
+    started = time.time()
+    with ResultDir(a.out) as rd:
+        ev = _evaluator(a)
+        try:
+            for g in gaits_:
+                bar, cb = _progress(f"NSGA-II {g}", rs.gens, not a.quiet)
+                try:
+                    results[g] = optimize_primary(g, rs, rd, *a.bounds, SimSettings(), ev, cb,
+                                                  robust_objective=a.robustness_objective,
+                                                  lock_objective=a.lock_time_objective)
+                finally:
+                    bar.close()
+        except Exception:
+            # A run that fails (not one that is interrupted) must not block the next one: its
+            # checkpoints go (not a file this run did not write, such as an unreadable one).
+            for g in gaits_:
+                ck = rd.state(checkpoint_name(g))
+                if ck.exists() and ck.stat().st_mtime >= started:
+                    ck.unlink()
+            raise
+        finally:
+            if ev is not None:
+                ev.close()
+        table = comparison_markdown(results, None)
+        if len(results) == 4:
+            io.write_text(rd.path("comparison.md"), table)
+        rd.commit()
+    for g in gaits_:
+        rd.state(checkpoint_name(g)).unlink(missing_ok=True)
     print(table)
     print(f"results in {a.out}/: <gait>.json, <gait>_population.csv, <gait>_pareto.csv, "
           f"<gait>_pareto.png" + (", comparison.md" if len(results) == 4 else ""))
@@ -174,8 +297,10 @@ def cmd_optimize(a) -> int:
 def cmd_secondary(a) -> int:
     from cpg import io, morris_lecar as ml
     from cpg.optimize import SECONDARY_TARGETS, RunSettings
+    from cpg.outdir import ResultDir
     from cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
+    out_dir(a.out)
     rs = RunSettings(a.pop, a.gens, a.seed)
     primary, weights = {}, {}
     for g in ml.PRIMARY_GAITS:
@@ -187,50 +312,64 @@ def cmd_secondary(a) -> int:
             weights[g] = list(ml.preset(g).weights)
     print("base weights: " + ", ".join(
         f"{g} {'(optimiser)' if g in primary else '(paper)'}" for g in weights), file=sys.stderr)
-    ev = _evaluator(a)
-    try:
-        bar, advance = _progress("symmetry breaking", rs.gens, not a.quiet)
-        target = iter(range(1, len(SECONDARY_TARGETS) + 1))
+    with ResultDir(a.out) as rd:
+        ev = _evaluator(a)
+        try:
+            bar, advance = _progress("symmetry breaking", rs.gens, not a.quiet)
+            target = iter(range(1, len(SECONDARY_TARGETS) + 1))
 
-        def prog(gen, n):  # one bar, reset for each target
-            if gen == 1:
-                bar.reset(total=n)
-                bar.set_description(f"target {next(target)}/{len(SECONDARY_TARGETS)}")
-            advance(gen, n)
+            def prog(gen, n):  # one bar, reset for each target
+                if gen == 1:
+                    bar.reset(total=n)
+                    bar.set_description(f"target {next(target)}/{len(SECONDARY_TARGETS)}")
+                advance(gen, n)
 
-        results = secondary_all(weights, rs, evaluator=ev, progress=prog)
-        bar.close()
-    finally:
-        if ev is not None:
-            ev.close()
-    write_secondary(a.out, results)
-    table = comparison_markdown(primary if len(primary) == 4 else {}, results)
-    io.write_text(os.path.join(a.out, "comparison.md"), table)
+            results = secondary_all(weights, rs, evaluator=ev, progress=prog)
+            bar.close()
+        finally:
+            if ev is not None:
+                ev.close()
+        write_secondary(rd.path("secondary.json"), results)
+        table = comparison_markdown(primary if len(primary) == 4 else {}, results)
+        io.write_text(rd.path("comparison.md"), table)
+        rd.commit()
     print(table)
     return 0
 
 
 # ------------------------------------------------------------------------- physical biped
-def _weights_arg(a):
-    """(gait, weights or None, source label) from --gait and --weights FILE."""
+def _network(a):
+    """(Network, label) from --network, --preset, --weights and --seed."""
+    from cpg.network import build
+
+    kind = a.network
+    preset = a.preset or a.gait
     if a.weights is None:
-        return a.gait, None, "paper Table 2"
-    from cpg.search import load_result
+        net = build(kind, preset, seed=a.seed)
+        return net, f"{kind} {preset}" + (f", seed {a.seed}" if a.seed is not None else "")
+    if kind != "ml":
+        raise _input_error("--weights holds Morris-Lecar weights: use it with --network ml")
+    from cpg.results import load_result
 
     data = load_result(a.weights)
-    if a.gait != data["gait"]:
-        print(f"cpgbiped: note: {a.weights} was optimised for {data['gait']}; using it for "
-              f"{a.gait}", file=sys.stderr)
-    return a.gait, data["chosen"]["weights"], a.weights
+    preset = a.preset or data["gait"]
+    net = build("ml", preset, weights=data["chosen"]["weights"], i_app=data["i_app"],
+                phi=data["phi"], seed=a.seed)
+    return net, f"ml {preset} with the weights of {a.weights}"
 
 
-def _push(a):
-    if a.push is None:
-        return None
-    t, imp = a.push
-    if not (t >= 0 and abs(imp) < 1e4):
-        raise _input_error(f"--push needs a time >= 0 s and an impulse below 1e4 N s, got {a.push}")
-    return (t, imp)
+def _validation(a, stop_on_fall=True, settle_s=None):
+    from envs.criteria import SETTLE_S
+    from envs.validate import check_gait, validate
+
+    check_gait(a.gait)
+    net, label = _network(a)
+    net.period()  # a network without a rhythm cannot drive the body: one line, before any work
+    v = validate(net, a.gait, a.seconds, friction_scale=a.friction_scale,
+                 push=getattr(a, "push", None), stop_on_fall=stop_on_fall,
+                 settle_s=SETTLE_S if settle_s is None else settle_s,
+                 ankle_drive=not a.no_ankle_drive)
+    return v, label
 
 
 def _input_error(msg):
@@ -241,69 +380,86 @@ def _input_error(msg):
 
 def cmd_validate(a) -> int:
     from cpg import io
-    from envs.validate import metrics_table, validate
+    from envs.validate import metrics_table
 
-    gait, w, src = _weights_arg(a)
-    v = validate(gait, w, a.seconds, a.seed, a.friction_scale, _push(a))
+    out_file(a.rrd, "--rrd", ".rrd")
+    v, label = _validation(a)
     s = v.summary()
-    s["weights_source"] = src
+    s["source"] = label
     if a.rrd:
         from envs.record import write_rrd
 
-        write_rrd(a.rrd, {gait: (v.recording, v.metrics)})
+        write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)})
     if a.json:
         print(io.to_json(s))
     else:
-        print(f"{gait} ({src}), {a.seconds:g} s after {2.0:g} s settling"
-              + (f", friction x{a.friction_scale:g}" if a.friction_scale != 1 else ""))
-        print(metrics_table({gait: s}))
+        print(f"{label} drives the body; target {a.gait}; {a.seconds:g} s after "
+              f"{v.settle_s:g} s settling"
+              + (f", friction x{a.friction_scale:g}" if a.friction_scale != 1 else "")
+              + (", CPG ankle drive removed" if a.no_ankle_drive else ""))
+        print(metrics_table({a.gait: s}))
+        for f in s["failures"]:
+            print(f"  not met: {f}")
         if s["unstable"]:
             print(f"physics: {s['unstable']}")
     return 0
 
 
 def cmd_render(a) -> int:
-    from envs.render import check_backend, check_video_size, gait_diagram, render_video, signals_picture
+    from envs.render import (check_backend, check_video_size, gait_cycle_picture, gait_diagram,
+                             render_video, signals_picture)
 
     check_video_size(a.width, a.height, a.fps, a.seconds)
-    if not a.out.endswith(".mp4"):
-        raise _input_error(f"--out must name an .mp4 file, got {a.out!r}")
+    out_file(a.out, "--out", ".mp4")
+    out_file(a.rrd, "--rrd", ".rrd")
     check_backend()
-    from envs.validate import validate
-
-    gait, w, src = _weights_arg(a)
-    v = validate(gait, w, a.seconds, a.seed, a.friction_scale, None, settle_s=0.0,
-                 record_qpos=True)
+    v, label = _validation(a, stop_on_fall=False, settle_s=0.0)
     path = render_video(v.recording, a.out, a.fps, a.width, a.height, a.seconds,
                         signals=not a.no_signals, fancy=a.fancy)
     stem = os.path.splitext(a.out)[0]
-    gait_diagram(v.recording, stem + "_gait.png", v.metrics, f"{gait} ({src})")
-    signals_picture(v.recording, stem + "_signals.png", f"{gait} ({src})")
+    gait_diagram(v.recording, stem + "_gait.png", v.metrics, label)
+    gait_cycle_picture(v.recording, v.metrics, stem + "_cycle.png", label)
+    signals_picture(v.recording, stem + "_signals.png", label)
     if a.rrd:
         from envs.record import write_rrd
 
-        write_rrd(a.rrd, {gait: (v.recording, v.metrics)}, {gait: path})
-    print(f"wrote {path}, {stem}_gait.png, {stem}_signals.png" + (f", {a.rrd}" if a.rrd else ""))
+        write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)}, {a.gait: path})
+    print(f"wrote {path}, {stem}_gait.png, {stem}_cycle.png, {stem}_signals.png"
+          + (f", {a.rrd}" if a.rrd else ""))
     return 0
 
 
 def cmd_log(a) -> int:
     from envs.record import write_rrd
-    from envs.validate import validate
 
-    if not a.rrd.endswith(".rrd"):
-        raise _input_error(f"--rrd must name an .rrd file, got {a.rrd!r}")
-    gait, w, src = _weights_arg(a)
-    v = validate(gait, w, a.seconds, a.seed, a.friction_scale, _push(a))
-    write_rrd(a.rrd, {gait: (v.recording, v.metrics)})
-    print(f"wrote {a.rrd} ({gait}, {src}; physical: {v.metrics.physical_gait}); open it with: "
+    out_file(a.rrd, "--rrd", ".rrd")
+    v, label = _validation(a)
+    write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)})
+    print(f"wrote {a.rrd} ({label}; physical: {v.metrics.physical_gait}); open it with: "
           f"rerun {a.rrd}")
+    return 0
+
+
+def cmd_matrix(a) -> int:
+    from cpg import io
+    from envs.matrix import matrix, matrix_table
+
+    res = matrix(a.network, seconds=a.seconds, seed=a.seed, workers=a.workers)
+    if a.json:
+        print(io.to_json(res))
+    else:
+        print(f"every {a.network} preset through the one controller ({a.seconds:g} s after "
+              f"settling" + (f", random initial CPG state from seed {a.seed}" if a.seed is not None
+                            else "") + "):")
+        print(matrix_table(res))
     return 0
 
 
 def cmd_check_pareto(a) -> int:
     from envs.pareto import check_pareto
 
+    out_dir(a.out)
+    out_file(a.rrd, "--rrd", ".rrd")
     res = check_pareto(a.result, a.out, first=a.first, seconds=a.seconds, render=a.render,
                        rrd=a.rrd, workers=a.workers, progress=not a.quiet)
     print(res["markdown"])
@@ -315,6 +471,7 @@ def cmd_check_pareto(a) -> int:
 def cmd_demo(a) -> int:
     from envs.demo import run_demo
 
+    out_dir(a.out)
     run_demo(a.out, seconds=a.seconds, video_seconds=a.video_seconds, progress=not a.quiet)
     return 0
 
@@ -339,32 +496,58 @@ def build_parser() -> argparse.ArgumentParser:
         <gait>.mp4, <gait>_gait.png, <gait>_signals.png, <gait>_frame.png, demo.rrd,
         summary.json and README.md with the table and the pictures.""")
     sp.add_argument("--out", default="out/demo", help="output folder (default: out/demo)")
-    sp.add_argument("--seconds", type=float, default=20.0, help="validated seconds per gait")
-    sp.add_argument("--video-seconds", type=float, default=8.0, help="seconds of video per gait")
+    sp.add_argument("--seconds", type=seconds_arg, default=20.0, help="validated seconds per gait")
+    sp.add_argument("--video-seconds", type=seconds_arg, default=8.0, help="seconds of video per gait")
     sp.add_argument("--quiet", action="store_true", help="no progress bar")
 
     def rollout_args(sp, rrd_required=False):
-        sp.add_argument("--gait", default="walk", help="walk, run, jump or hop (default walk)")
+        sp.add_argument("--gait", default="walk",
+                        help="the target the verdict checks: walk, run, jump or hop (default walk)")
+        sp.add_argument("--network", default="ml", choices=("ml", "hopf", "matsuoka"),
+                        help="the network that drives the body (default ml: Morris-Lecar)")
+        sp.add_argument("--preset", default=None,
+                        help="the network's preset (default: the --gait; matsuoka: walk)")
         sp.add_argument("--weights", metavar="FILE",
-                        help="optimiser result JSON whose chosen (w_a, w_b, w_c) to use")
-        sp.add_argument("--seconds", type=float, default=20.0,
-                        help="simulated seconds after 2 s of settling (default 20)")
-        sp.add_argument("--seed", type=int, default=None,
-                        help="random initial CPG state from this seed (default: Table 3 state)")
-        sp.add_argument("--friction-scale", type=float, default=1.0, metavar="F",
+                        help="optimiser result JSON: its chosen (w_a, w_b, w_c), I_app and phi "
+                             "replace the Morris-Lecar preset's")
+        sp.add_argument("--seconds", type=seconds_arg, default=20.0,
+                        help="simulated seconds measured after 2 s of settling (default 20)")
+        sp.add_argument("--seed", type=seed_arg, default=None,
+                        help="random initial CPG state from this seed (default: the preset's)")
+        sp.add_argument("--friction-scale", type=positive_arg, default=1.0, metavar="F",
                         help="multiply every floor/foot friction coefficient by F")
+        sp.add_argument("--no-ankle-drive", action="store_true",
+                        help="remove the CPG's ankle drive (the reflexes stay): the ablation")
         sp.add_argument("--rrd", required=rrd_required, metavar="FILE.rrd",
                         help="also write a rerun recording")
 
-    sp = add("validate", cmd_validate, "drive the biped with a gait and measure it", """\
-        Run the CPG-driven biped and measure the gait from its foot contacts (debounced):
-        duty factor per foot, left-right phase lag (fraction of a stride), double support,
-        flight, stride period, distance, speed; a physical verdict (walk/run/jump/hop/none)
-        from those numbers alone, next to the gait the CPG classifier names from the cell
-        outputs. PASS when both agree with --gait and the body did not fall.""")
+    sp = add("validate", cmd_validate, "drive the biped with a network and measure the gait", """\
+        A network (--network, --preset, --weights; default the Morris-Lecar preset of --gait)
+        drives the biped through the one controller, which never sees a gait name. The gait
+        is measured from the foot contacts (debounced): duty factor per foot, left-right
+        phase lag (fraction of a stride), double support, flight, stride period, distance,
+        speed; a physical verdict (walk/run/jump/hop/none) from those numbers alone, next to
+        the gait the CPG classifier names from the cell outputs. --gait is only the target:
+        PASS when the body did not fall, both verdicts name it and its criteria are met.
+        Times (--push, fell_at_s) are simulation time from the start, settling included.""")
     rollout_args(sp)
-    sp.add_argument("--push", type=float, nargs=2, metavar=("T_S", "IMPULSE_NS"),
-                    help="horizontal impulse on the torso at time T_S (N s)")
+    sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"),
+                    help="horizontal impulse on the torso at time T_S s (simulation time from "
+                         "the start, settling included) of IMPULSE_NS N s")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+
+    sp = add("matrix", cmd_matrix, "every preset of a network through the one controller", """\
+        Drive the body with every preset of a network (ml: walk, run, jump, hop; hopf: the
+        same four; matsuoka: walk) through the same controller and print the physical gait
+        each one produces, with its metrics. The controller never sees the preset's name:
+        the physical gait comes from the CPG alone, so a diagonal matrix (each preset its own
+        gait) shows that the CPG, not a label, chooses the gait.""")
+    sp.add_argument("--network", default="ml", choices=("ml", "hopf", "matsuoka"))
+    sp.add_argument("--seed", type=seed_arg, default=None,
+                    help="random initial CPG states from this seed (default: the presets')")
+    sp.add_argument("--seconds", type=seconds_arg, default=20.0,
+                    help="simulated seconds after 2 s of settling (default 20)")
+    sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("render", cmd_render, "render a rollout off-screen to mp4", """\
@@ -372,11 +555,12 @@ def build_parser() -> argparse.ArgumentParser:
         egl accepted) to an mp4 (mediapy/ffmpeg), frames taken by simulated time; a side
         camera tracks the torso, foot markers turn green in stance; a strip of the four CPG
         signals runs below unless --no-signals. Also writes FILE_gait.png (footfall
-        diagram) and FILE_signals.png beside the video.""")
+        diagram), FILE_cycle.png (joint angles and vertical ground reaction force over the
+        gait cycle, mean +- s.d. over strides) and FILE_signals.png beside the video.""")
     rollout_args(sp)
-    sp.add_argument("--width", type=int, default=640)
-    sp.add_argument("--height", type=int, default=480)
-    sp.add_argument("--fps", type=float, default=30.0)
+    sp.add_argument("--width", type=count_arg(1), default=640)
+    sp.add_argument("--height", type=count_arg(1), default=480)
+    sp.add_argument("--fps", type=positive_arg, default=30.0)
     sp.add_argument("--fancy", action="store_true", help="shadows and reflections (slower)")
     sp.add_argument("--no-signals", action="store_true", help="no CPG strip under the video")
     sp.add_argument("--out", required=True, metavar="FILE.mp4")
@@ -388,7 +572,7 @@ def build_parser() -> argparse.ArgumentParser:
         touchdown/lift-off events and the gait metrics; the default view shows the gait
         diagram above the CPG signals. Open it with 'rerun FILE.rrd'.""")
     rollout_args(sp, rrd_required=True)
-    sp.add_argument("--push", type=float, nargs=2, metavar=("T_S", "IMPULSE_NS"))
+    sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"))
 
     sp = add("check-pareto", cmd_check_pareto, "run an optimiser result's Pareto points in physics",
              """\
@@ -397,11 +581,11 @@ def build_parser() -> argparse.ArgumentParser:
         processes, optionally render each, and write DIR/pareto_check.md, .csv and .json:
         weights, phase errors, physical metrics and PASS/fail per point.""")
     sp.add_argument("result", help="optimiser result JSON")
-    sp.add_argument("--first", type=int, default=None, metavar="N", help="only the first N points")
-    sp.add_argument("--seconds", type=float, default=20.0)
+    sp.add_argument("--first", type=count_arg(1), default=None, metavar="N", help="only the first N points")
+    sp.add_argument("--seconds", type=seconds_arg, default=20.0)
     sp.add_argument("--render", action="store_true", help="render each point to video")
     sp.add_argument("--rrd", metavar="FILE.rrd", help="log every point to one recording")
-    sp.add_argument("--workers", type=int, default=2, help="parallel processes (default 2)")
+    sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
     sp.add_argument("--out", required=True, metavar="DIR")
     sp.add_argument("--quiet", action="store_true")
 
@@ -425,7 +609,7 @@ def build_parser() -> argparse.ArgumentParser:
         paper's white noise (L = 1.5), next to the calibrated preset that reaches the claimed
         1 Hz. See cpg/matsuoka.py for the calibration and why.""")
     sp.add_argument("--json", action="store_true", help="print JSON")
-    sp.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    sp.add_argument("--seed", type=seed_arg, default=0, help="noise seed (default 0)")
 
     sp = add("optimize", cmd_optimize, "NSGA-II search of (w_a, w_b, w_c) for primary gaits", """\
         Search the three symmetric coupling weights with NSGA-II (pymoo) for a primary gait,
@@ -438,16 +622,16 @@ def build_parser() -> argparse.ArgumentParser:
         running the same command again after an interrupt resumes from it.
         Defaults (pop 40, 25 generations) reach errors below 1 degree for all four gaits.""")
     sp.add_argument("--gait", default="all", help="walk, run, jump, hop or all (default all)")
-    sp.add_argument("--pop", type=int, default=40, help="population size (default 40)")
-    sp.add_argument("--gens", type=int, default=25, help="generations (default 25)")
-    sp.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    sp.add_argument("--pop", type=count_arg(4), default=40, help="population size (default 40)")
+    sp.add_argument("--gens", type=count_arg(1), default=25, help="generations (default 25)")
+    sp.add_argument("--seed", type=seed_arg, default=0, help="random seed (default 0)")
     sp.add_argument("--bounds", type=float, nargs=2, default=[-1.0, 1.0], metavar=("LO", "HI"),
                     help="search box for every weight (default -1 1)")
-    sp.add_argument("--checkpoint-every", type=int, default=5, metavar="N",
+    sp.add_argument("--checkpoint-every", type=count_arg(1), default=5, metavar="N",
                     help="checkpoint interval in generations (default 5)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",
                     help="evaluate on Dask: a LocalCluster, or the scheduler at tcp://host:port")
-    sp.add_argument("--robustness-objective", type=int, default=0, metavar="N",
+    sp.add_argument("--robustness-objective", type=count_arg(0), default=0, metavar="N",
                     help="add the objective 1 - fraction of N random initial states reaching "
                          "the gait (N+1 integrations per individual)")
     sp.add_argument("--lock-time-objective", action="store_true",
@@ -466,9 +650,9 @@ def build_parser() -> argparse.ArgumentParser:
         from at least 80% of all states. Writes DIR/secondary.json and DIR/comparison.md.""")
     sp.add_argument("--results", default="out/optimize",
                     help="folder with <gait>.json optimiser results (default out/optimize)")
-    sp.add_argument("--pop", type=int, default=40, help="population size (default 40)")
-    sp.add_argument("--gens", type=int, default=30, help="generations per target (default 30)")
-    sp.add_argument("--seed", type=int, default=0)
+    sp.add_argument("--pop", type=count_arg(4), default=40, help="population size (default 40)")
+    sp.add_argument("--gens", type=count_arg(1), default=30, help="generations per target (default 30)")
+    sp.add_argument("--seed", type=seed_arg, default=0)
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",
                     help="evaluate on Dask: a LocalCluster, or the scheduler at tcp://host:port")
     sp.add_argument("--out", default="out/optimize", help="output folder (default out/optimize)")
@@ -481,8 +665,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--gait", default="walk", help="walk, run, jump or hop (default walk)")
     sp.add_argument("--beta", type=float, default=0.6, help="duty factor in (0, 1)")
     sp.add_argument("--normalised", action="store_true", help="normalised coupling variant")
-    sp.add_argument("--seconds", type=float, default=20.0, help="simulated seconds")
-    sp.add_argument("--seed", type=int, default=0)
+    sp.add_argument("--seconds", type=seconds_arg, default=20.0, help="simulated seconds")
+    sp.add_argument("--seed", type=seed_arg, default=0)
     sp.add_argument("--json", action="store_true")
     return p
 
@@ -491,8 +675,13 @@ GL_BACKENDS = ("osmesa", "egl", "glfw")
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line; every failure is one line on stderr: exit 2 for bad input, 1 for
+    anything unexpected ("internal error"; the traceback only with --debug), 130 on Ctrl-C."""
     from cpg.errors import InputError
 
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv
+    argv = [a for a in argv if a != "--debug"]
     try:
         args = build_parser().parse_args(argv)
         gl = os.environ.get("MUJOCO_GL")
@@ -507,6 +696,15 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("cpgbiped: interrupted", file=sys.stderr)
         return 130
+    except Exception as e:  # noqa: BLE001 - the last resort: one line, never a bare traceback
+        if debug:
+            import traceback
+
+            traceback.print_exc()
+        msg = " ".join(str(e).split()) or "(no message)"
+        print(f"cpgbiped: internal error: {type(e).__name__}: {msg}"
+              + ("" if debug else " (run again with --debug for the traceback)"), file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

@@ -1,0 +1,131 @@
+"""The rerun recording shows the body: geometry from the model, poses per tick, forces only in
+contact, the footfall lanes, and a blueprint that uses them; the web viewer draws it."""
+import os
+import shutil
+import subprocess
+import sys
+
+import mujoco
+import numpy as np
+import pytest
+
+from cpg.errors import InputError
+from cpg.network import build
+from envs.biped import load_model
+from envs.gait_metrics import debounce
+from envs.record import blueprint, read_component, write_rrd
+from envs.validate import validate
+
+SECONDS = 6.0
+
+
+@pytest.fixture(scope="module")
+def logged(tmp_path_factory):
+    """`cpgbiped log --gait walk` and the same deterministic rollout in this process."""
+    rrd = tmp_path_factory.mktemp("rrd") / "walk.rrd"
+    r = subprocess.run([sys.executable, "-m", "envs.cli", "log", "--gait", "walk", "--seconds",
+                        str(SECONDS), "--rrd", str(rrd)], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    return rrd, validate(build("ml", "walk"), "walk", SECONDS)
+
+
+def test_every_body_has_static_geometry(logged):
+    rrd, _ = logged
+    m = load_model()
+    kinds = ("Capsules3D:lengths", "Boxes3D:half_sizes", "Ellipsoids3D:half_sizes",
+             "Cylinders3D:lengths")
+    for b in range(1, m.nbody):
+        body = m.body(b).name
+        geoms = [m.geom(g).name for g in np.nonzero(m.geom_bodyid == b)[0]]
+        assert geoms, body
+        for g in geoms:
+            found = [read_component(rrd, f"/walk/world/body/{body}/{g}", k) for k in kinds]
+            static = [rows for t, rows in found if rows]
+            assert static and all(t is None for t, rows in found if rows), (body, g)
+    t, floor = read_component(rrd, "/walk/world/floor/floor", "Boxes3D:half_sizes")
+    assert t is None and floor
+
+
+def test_body_poses_match_the_simulation_within_1_mm(logged):
+    """Recompute every body's position from the rollout's recorded joint positions (forward
+    kinematics in MuJoCo) and compare with the logged transforms, tick by tick."""
+    rrd, v = logged
+    rec = v.recording
+    m = load_model()
+    d = mujoco.MjData(m)
+    want = np.empty((len(rec.t), m.nbody, 3))
+    for k, q in enumerate(rec.qpos):
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        want[k] = d.xpos
+    for b in range(1, m.nbody):
+        t, rows = read_component(rrd, f"/walk/world/body/{m.body(b).name}",
+                                 "Transform3D:translation")
+        assert len(t) == len(rec.t) and np.allclose(t, rec.t, atol=1e-9)
+        got = np.array([r[0] for r in rows])
+        assert np.max(np.abs(got - want[:, b])) < 1e-3, m.body(b).name
+
+
+def test_force_arrows_only_in_contact(logged):
+    rrd, v = logged
+    rec = v.recording
+    for i, leg in enumerate(("left", "right")):
+        t, rows = read_component(rrd, f"/walk/world/grf/{leg}", "Arrows3D:vectors")
+        on = debounce(rec.contact[:, i], rec.dt)
+        assert len(rows) == len(on)
+        shown = np.array([bool(r) for r in rows])
+        assert np.array_equal(shown, on)
+        # Upward, the measured normal force at 0.5 m per body weight.
+        weight = load_model().body_mass.sum() * 9.81
+        lengths = np.array([r[0][2] for r in rows if r])
+        assert np.allclose(lengths, 0.5 * rec.force[on, i] / weight, rtol=1e-5, atol=1e-6)
+        assert np.mean(lengths) > 0.1
+    t, states = read_component(rrd, "/walk/feet/left", "StateChange:state")
+    assert set(s[0] for s in states) == {"stance", "swing"}
+
+
+def test_blueprint_views_use_the_logged_paths():
+    rec = validate(build("ml", "walk"), "walk", 2.0, settle_s=0.0)
+    bp = blueprint({"walk": (rec.recording, rec.metrics)}, {"walk": "walk.mp4"})
+
+    import rerun.blueprint as rrb
+
+    def views(c):
+        for x in c.contents:
+            yield from [x] if isinstance(x, rrb.View) else views(x)
+
+    found = {str(v.origin): type(v).__name__ for v in views(bp.root_container)}
+    assert found == {"/walk/world": "Spatial3DView", "/walk/video": "Spatial2DView",
+                     "/walk/feet": "StateTimelineView", "/walk/cpg": "TimeSeriesView",
+                     "/walk/activation": "TimeSeriesView", "/walk/joints": "TimeSeriesView",
+                     "/walk/metrics": "TextDocumentView"}
+
+
+def test_a_model_without_the_feet_is_refused(tmp_path):
+    from models import BIPED_DIR
+
+    for f in ("biped.xml", "scene.xml"):
+        shutil.copy(BIPED_DIR / f, tmp_path / f)
+    v = validate(build("ml", "walk"), "walk", 1.0, settle_s=0.0)
+    xml = (tmp_path / "biped.xml").read_text().replace('name="left_foot"', 'name="left_paw"')
+    (tmp_path / "biped.xml").write_text(xml)
+    v.recording.xml_path = str(tmp_path / "scene.xml")
+    out = tmp_path / "x.rrd"
+    with pytest.raises(InputError, match="left_foot"):
+        write_rrd(out, {"walk": (v.recording, v.metrics)})
+    assert not out.exists() and not [p for p in tmp_path.iterdir() if p.suffix == ".rrd"]
+
+
+def test_the_web_viewer_draws_the_body_and_the_footfalls(logged, tmp_path):
+    """The same script as the README's screenshot: rerun's web viewer in headless Chromium."""
+    rrd, _ = logged
+    png = tmp_path / "viewer.png"
+    script = os.path.join(os.path.dirname(__file__), "..", "scripts", "check_rerun_viewer.py")
+    r = subprocess.run([sys.executable, script, str(rrd), str(png), "--json", "--wait", "30"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    import json
+
+    res = json.loads(r.stdout)
+    assert res["loaded"] and res["body"] and res["footfalls"], res
