@@ -5,13 +5,13 @@ import sys
 
 import pytest
 
-from scripts.cli import main
+from envs.cli import main
 
 TARGETS = {"walk": (180, 180, 0), "run": (180, 0, 180), "jump": (0, 180, 180), "hop": (0, 0, 0)}
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "scripts.cli", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
                           text=True, timeout=600)
 
 
@@ -76,7 +76,7 @@ def test_optimize_bad_input_writes_nothing(tmp_path, args, msg):
 
 
 def test_optimize_unreadable_checkpoint(tmp_path):
-    (tmp_path / ".hop.checkpoint.pkl").write_bytes(b"garbage")
+    (tmp_path.parent / f".{tmp_path.name}.hop.checkpoint.pkl").write_bytes(b"garbage")
     r = run("optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--quiet",
             "--out", str(tmp_path))
     assert r.returncode == 2 and "unreadable checkpoint" in r.stderr

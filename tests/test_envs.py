@@ -101,37 +101,18 @@ def test_fall_sensors_see_a_body_on_the_floor():
             d.qpos[m.jnt_qposadr[m.joint("rootz").id]] = -0.8
         mujoco.mj_forward(m, d)
         rec = np.zeros((1, K.R_SIZE))
-        verdicts.append(K.record(0, 0.0, d.qpos, d.sensordata, d.xpos, d.act, ix, np.zeros(4), rec,
-                                 -np.inf, np.inf))
+        verdicts.append(K.record(0, 0.0, d.qpos, d.sensordata, d.xpos, d.act, d.ctrl,
+                                 d.actuator_force, d.actuator_velocity, ix, np.zeros(4),
+                                 np.zeros(4), K.new_state(), rec, -np.inf, np.inf))
     assert verdicts == [0, 1]
-
-
-def test_ankle_muscles_get_the_documented_map_of_the_cpg():
-    """Walk (no ankle reflex): each ankle muscle's control is ankle_gain * sigmoid of its own
-    cell's output, sampled from the schedule at t_model = t_model0 + time_scale * t."""
-    from envs.biped import load_model
-    from envs.controller import GAIT_CONTROL, CPGController, activation, cpg_schedule, preset_network
-
-    net, p = preset_network("walk"), GAIT_CONTROL["walk"]
-    m = load_model()
-    d = mujoco.MjData(m)
-    mujoco.mj_forward(m, d)
-    sched = cpg_schedule(*net, t_model_end=60.0)
-    ctrl = CPGController(m, d, sched, p, t_model0=3.0)
-    for t in (0.0, 0.37, 1.9):
-        u = ctrl(t).copy()
-        tm = 3.0 + p.time_scale * t
-        v = np.array([np.interp(tm, sched.t_model, sched.v[:, c]) for c in range(4)])
-        assert np.allclose(ctrl.last_v, v, atol=1e-9)
-        assert np.allclose(u[:4], p.ankle_gain * activation(v, p), atol=1e-9)
 
 
 @pytest.mark.parametrize("gait", ["walk", "run", "jump", "hop"])
 def test_environment_with_zero_residual_produces_the_gait(gait):
     """The dm_control environment steps the same CPG controller as the validated rollouts:
     with a zero residual action the body stays up and its contacts name its gait."""
-    from envs.biped import FALL_HEIGHT, FALL_PITCH
     from envs.gait_metrics import measure
+    from envs.rollout import FALL_HEIGHT, FALL_PITCH
 
     env = envs.load(gait, random=1, time_limit=12.0)
     ts = env.reset()

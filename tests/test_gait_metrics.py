@@ -82,3 +82,57 @@ def test_footfalls_per_stride_counts_a_stuttering_foot():
     assert m.stride_period_s == pytest.approx(period, abs=2 * DT)  # the right foot's strides
     assert m.footfalls_per_stride["right"] == pytest.approx(1.0, abs=0.06)
     assert m.footfalls_per_stride["left"] == pytest.approx(2.0, abs=0.12)
+
+
+def test_apex_height_of_known_parabolas():
+    """Flights of a ballistic centre of mass z = z0 + v0 t - g t^2 / 2 rise v0^2 / (2 g)."""
+    t = np.arange(0.0, 6.0, DT)
+    z = np.full_like(t, 0.8)
+    flight = np.zeros(len(t), bool)
+    rises = []
+    for k, start in enumerate(np.arange(0.5, 5.5, 1.0)):
+        v0 = 1.0 + 0.1 * k
+        tf = 2 * v0 / gm.G
+        sel = (t >= start) & (t < start + tf)
+        z[sel] = 0.8 + v0 * (t[sel] - start) - gm.G * (t[sel] - start) ** 2 / 2
+        flight |= sel
+        rises.append(v0 ** 2 / (2 * gm.G))
+    assert gm.apex_height(z, flight) == pytest.approx(np.median(rises), rel=1e-3)
+    assert gm.apex_height(z, np.zeros(len(t), bool)) == 0.0
+
+
+def test_stride_regularity_of_a_period_2_gait():
+    """Strides alternating 0.9 and 1.1 s: cv = 0.1, period-2 index = 0.2; a regular gait 0."""
+    d = np.tile([0.9, 1.1], 10)
+    td = np.concatenate([[0.0], np.cumsum(d)])
+    cv, p2 = gm.stride_regularity({"left": td, "right": td + 0.5})
+    assert cv == pytest.approx(0.1, rel=1e-9) and p2 == pytest.approx(0.2, rel=1e-9)
+    cv, p2 = gm.stride_regularity({"left": np.arange(0, 20.0, 1.0), "right": np.arange(0.5, 20, 1)})
+    assert cv == pytest.approx(0.0, abs=1e-12) and p2 == pytest.approx(0.0, abs=1e-12)
+
+
+def test_froude_stride_length_cot_and_work_shares_by_construction():
+    """A walk at 1 m/s with 1 s strides, one actuator (left ankle) giving a constant 50 W only
+    while its foot is on the ground: Froude 1 / (g L), stride 1 m, positive work 50 W x stance
+    time, CoT = work / (m g distance), the ankle does all the stance work."""
+    c, x = series(1.0, 0.65, 0.5, speed=1.0)
+    m = gm.measure(T, c, x, settle_s=2.0)
+    power = np.zeros((len(T), 3))
+    power[:, 0] = np.where(c[:, 0], 50.0, -20.0)  # negative work does not count
+    L, mass = 0.862, 21.0
+    b = gm.biomechanics(T, c, x, np.full(len(T), 0.8), power, np.array(["ankle", "hip", "knee"]),
+                        np.array([0, 0, 1]), m, L, mass, settle_s=2.0)
+    assert b.froude == pytest.approx(1.0 / (gm.G * L), rel=1e-3)
+    assert b.stride_length_m == pytest.approx(1.0, abs=0.01)
+    assert b.relative_stride_length == pytest.approx(1.0 / L, abs=0.02)
+    window = T[-1] - 2.0
+    want = 50.0 * 0.65 * window
+    assert b.positive_work_J == pytest.approx(want, rel=0.01)
+    assert b.cost_of_transport == pytest.approx(want / (mass * gm.G * m.distance_m), rel=0.01)
+    assert b.stance_work_share == {"hip": 0.0, "knee": 0.0, "ankle": 1.0}
+    # In place: no cost of transport, the work per stride instead.
+    still = gm.measure(T, c, np.zeros(len(T)), settle_s=2.0)
+    b = gm.biomechanics(T, c, np.zeros(len(T)), np.full(len(T), 0.8), power,
+                        np.array(["ankle", "hip", "knee"]), np.array([0, 0, 1]), still, L, mass,
+                        settle_s=2.0)
+    assert b.cost_of_transport is None and b.work_per_stride_J == pytest.approx(50 * 0.65, rel=0.02)

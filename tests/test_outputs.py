@@ -10,14 +10,15 @@ import pytest
 
 from envs.gait_metrics import edges
 from envs.record import read_rrd
+from cpg.network import build
 from envs.validate import validate
-from scripts.cli import main
+from envs.cli import main
 
 
 def cli(*args, env=None):
     e = dict(os.environ)
     e.update(env or {})
-    return subprocess.run([sys.executable, "-m", "scripts.cli", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
                           text=True, timeout=900, env=e)
 
 
@@ -31,9 +32,52 @@ def test_validate_json_keys(capsys):
     assert main(["validate", "--gait", "walk", "--seconds", "6", "--json"]) == 0
     s = json.loads(capsys.readouterr().out)
     for k in ("fell", "duty_factor", "lr_phase_lag", "double_support", "flight",
-              "stride_period_s", "distance_m", "speed_mps", "physical_gait", "cpg_gait"):
+              "stride_period_s", "distance_m", "speed_mps", "physical_gait", "cpg_gait",
+              "network", "preset", "settle_s", "ankle_drive"):
         assert k in s
     assert set(s["duty_factor"]) == {"left", "right"}
+    assert (s["network"], s["preset"], s["gait"], s["ankle_drive"]) == ("ml", "walk", "walk", True)
+
+
+def test_validate_separates_the_driver_from_the_target(capsys):
+    """--network/--preset choose what drives the body, --gait only what the verdict checks."""
+    assert main(["validate", "--gait", "walk", "--network", "hopf", "--preset", "jump",
+                 "--seconds", "4", "--no-ankle-drive", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert (s["network"], s["preset"], s["gait"], s["ankle_drive"]) == ("hopf", "jump", "walk",
+                                                                          False)
+
+
+def test_matrix_json(capsys):
+    assert main(["matrix", "--network", "matsuoka", "--seconds", "4", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["network"] == "matsuoka" and list(res["rows"]) == ["walk"]
+    assert {"physical_gait", "fell", "duty_factor", "flight"} <= set(res["rows"]["walk"])
+
+
+@pytest.mark.parametrize("args,msg", [
+    (["validate", "--network", "kuramoto"], "invalid choice"),
+    (["validate", "--preset", "trot"], "unknown ml preset"),
+    (["validate", "--network", "matsuoka", "--preset", "hop"], "unknown matsuoka preset"),
+    (["validate", "--gait", "walk", "--seed", "-5"], "non-negative"),
+    (["validate", "--push", "30", "10", "--seconds", "2"], "outside the rollout"),
+    (["validate", "--push", "inf", "10"], "finite"),
+    (["matrix", "--network", "ml", "--seed", "-1"], "seed"),
+    (["render", "--width", "100000", "--height", "100000", "--seconds", "1", "--out", "x.mp4"],
+     "off-screen buffer"),
+])
+def test_physics_bad_input_one_line(tmp_path, args, msg):
+    r = subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True, text=True,
+                       timeout=300, cwd=tmp_path)
+    one_line_error(r, msg)
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_network_without_rhythm_is_refused(tmp_path):
+    f = tmp_path / "rest.json"  # I_app = 0 and no coupling: every cell rests
+    f.write_text(json.dumps({"format": "cpgbiped.optimize/1", "gait": "walk", "i_app": 0.0,
+                             "phi": 0.254, "chosen": {"weights": [0, 0, 0]}, "pareto": []}))
+    one_line_error(cli("validate", "--weights", str(f)), "does not oscillate")
 
 
 def test_render_video(tmp_path):
@@ -45,13 +89,14 @@ def test_render_video(tmp_path):
     assert video.shape[0] == 20 and video.shape[1:3] == (120, 160)
     assert video.std() > 5  # not blank
     assert np.abs(video[-1].astype(int) - video[0].astype(int)).mean() > 1  # changes over time
-    assert (tmp_path / "walk_gait.png").exists() and (tmp_path / "walk_signals.png").exists()
+    for f in ("walk_gait.png", "walk_cycle.png", "walk_signals.png"):
+        assert (tmp_path / f).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
 @pytest.mark.parametrize("args,msg", [
     (["--width", "161", "--height", "120"], "odd"),
-    (["--seconds", "0"], "seconds must be positive"),
+    (["--seconds", "0"], "must be a number of seconds in (0, 600]"),
     (["--gait", "skip"], "unknown gait"),
 ])
 def test_render_bad_input_no_file(tmp_path, args, msg):
@@ -76,7 +121,7 @@ def test_rrd_contacts_match_validate(tmp_path):
     t, cpg = series["/walk/cpg"]  # one entity, a series per cell LF, RF, LE, RE
     assert cpg.shape == (len(t), 4) and len(t) > 100
     assert np.all(np.ptp(cpg, axis=0) > 0.1)
-    v = validate("walk", seconds=8.0)  # the same deterministic rollout
+    v = validate(build("ml", "walk"), "walk", 8.0)  # the same deterministic rollout
     dt_phys = v.recording.physics_dt
     t, joints = series["/walk/joints"]  # one entity, six series per row
     assert joints.shape == v.recording.joints.shape
@@ -97,6 +142,7 @@ def test_rrd_contacts_match_validate(tmp_path):
 def pareto_file(tmp_path):
     f = tmp_path / "hop.json"
     f.write_text(json.dumps({"format": "cpgbiped.optimize/1", "gait": "walk",
+                             "i_app": 0.229, "phi": 0.254,
                              "chosen": {"weights": [0.39, -0.681, 0.489], "errors_deg": [0, 0, 0]},
                              "pareto": [{"weights": [0.39, -0.681, 0.489], "errors_deg": [0, 0, 0]},
                                         {"weights": [0.3, -0.6, 0.5], "errors_deg": [0.1, 0, 0]}]}))
@@ -130,13 +176,13 @@ def test_check_pareto_bad_input(tmp_path):
     else:
         target = ro
     r = cli("check-pareto", str(pareto_file(tmp_path)), "--out", str(target), "--quiet")
-    one_line_error(r, "output folder")
+    one_line_error(r, "not a writable folder")
 
 
 def test_validate_bad_weights_file(tmp_path):
     f = tmp_path / "w.json"
-    f.write_text('{"format": "cpgbiped.optimize/1", "gait": "walk", "chosen": {"weights": '
-                 '[NaN, 0, 0]}, "pareto": []}')
+    f.write_text('{"format": "cpgbiped.optimize/1", "gait": "walk", "i_app": 0.229, "phi": 0.254, '
+                 '"chosen": {"weights": [NaN, 0, 0]}, "pareto": []}')
     one_line_error(cli("validate", "--weights", str(f)), "finite")
     f.write_text("{not json")
     one_line_error(cli("validate", "--weights", str(f)), "not readable JSON")
@@ -148,7 +194,7 @@ def test_demo_produces_everything(tmp_path):
     r = cli("demo", "--out", str(out), "--seconds", "4", "--video-seconds", "1", "--quiet")
     assert r.returncode == 0, r.stderr
     for g in ("walk", "run", "jump", "hop"):
-        for suffix in (".mp4", "_gait.png", "_signals.png", "_frame.png"):
+        for suffix in (".mp4", "_gait.png", "_cycle.png", "_signals.png", "_frame.png"):
             assert (out / f"{g}{suffix}").stat().st_size > 0
     assert (out / "demo.rrd").stat().st_size > 0
     readme = (out / "README.md").read_text()

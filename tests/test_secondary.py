@@ -22,7 +22,7 @@ def test_every_target_has_an_outcome(results, tmp_path):
         assert np.all(np.isfinite(list(r["directed_weights"].values())))
     md = comparison_markdown({}, results)
     assert md.count("\n| ") >= len(results) + 1
-    write_secondary(tmp_path, results)
+    write_secondary(tmp_path / "secondary.json", results)
     assert (tmp_path / "secondary.json").stat().st_size > 0
 
 

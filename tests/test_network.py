@@ -1,0 +1,135 @@
+"""The Network interface: one object per network, built in one place, that any driver can use."""
+import numpy as np
+import pytest
+
+from cpg import hopf, matsuoka as mt, morris_lecar as ml
+from cpg.errors import InputError, NotOscillatingError
+from cpg.gaits import classify
+from cpg.integrate import Schedule, simulate_ml
+from cpg.network import (HOPF_PRESETS, KINDS, ML_UNITS_PER_S, PRESETS, blend, build,
+                         ml_weights)
+from cpg.reproduce import run_preset
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_every_preset_yields_four_cells_in_0_1(kind):
+    for preset in PRESETS[kind]:
+        net = build(kind, preset)
+        out = net.outputs(3.0 * net.units_per_s)
+        assert out.v.shape[1] == 4 and not out.diverged
+        a = net.activation(out.v)
+        assert a.min() >= 0.0 and a.max() <= 1.0
+        assert a.max() > 0.9 and a.min() < 0.1  # bursts on and off within 3 s
+
+
+def test_ml_network_is_the_paper_preset():
+    """build("ml", g) holds Table 2's parameters and Table 3's state; its period is the one the
+    reproduction measures, and its time unit is one fixed number for every preset."""
+    for g in ml.PRIMARY_GAITS:
+        net = build("ml", g)
+        p = ml.preset(g)
+        assert (net.i_app, net.phi) == (p.i_app, p.phi)
+        assert np.allclose(net.W, ml.weight_matrix(p.weights)) and np.allclose(net.y0, p.y0)
+        assert net.period() == pytest.approx(run_preset(g).rhythm.period, rel=1e-3)
+        assert net.units_per_s == ML_UNITS_PER_S
+        assert net.period_s() == pytest.approx(net.period() / ML_UNITS_PER_S)
+
+
+def test_ml_weights_in_every_form():
+    w3 = (0.39, -0.681, 0.489)
+    W = ml.weight_matrix(np.array(w3))
+    assert np.allclose(ml_weights(w3), W)
+    assert np.allclose(ml_weights(ml.directed_vector(W)), W)
+    assert np.allclose(ml_weights(W), W)
+    with pytest.raises(InputError, match="3 symmetric"):
+        ml_weights([1.0, 2.0])
+
+
+def test_hopf_period_is_the_analytic_one():
+    """Large-a limit of the stance/swing oscillator: T = pi/omega_st + pi/omega_sw."""
+    for g, hp in HOPF_PRESETS.items():
+        assert build("hopf", g).period() == pytest.approx(hp.params.period, rel=0.05)
+
+
+def test_hopf_compiled_equals_numpy_reference():
+    p = hopf.HopfParams(normalised=True, k=2.0, beta=0.4)
+    y0 = hopf.random_states(4, 1, 5)[0]
+    a = hopf.simulate_one(hopf.gait_lags("run"), y0, p, t_end=5.0)
+    b = hopf.simulate(hopf.gait_lags("run"), y0[None], p, t_end=5.0)
+    assert np.allclose(a.x, b.x, atol=1e-10)
+
+
+def test_matsuoka_network_is_the_calibrated_ankle_pair():
+    net = build("matsuoka", "walk")
+    assert net.period_s() == pytest.approx(1.0, rel=0.03)  # the calibration's 1 Hz
+    full = mt.simulate(mt.CALIBRATED, t_end=2.0, seed=0)
+    out = net.outputs(2.0)
+    assert np.allclose(out.v, full.x[0][:, [5, 11, 4, 10]])  # L/R ankle flexor, extensor
+
+
+def test_random_state_from_seed_is_reproducible():
+    a, b = build("ml", "run", seed=3), build("ml", "run", seed=3)
+    assert np.array_equal(a.y0, b.y0) and not np.array_equal(a.y0, build("ml", "run").y0)
+
+
+@pytest.mark.parametrize("kw,msg", [
+    (dict(kind="kuramoto"), "unknown network"),
+    (dict(kind="ml", preset="trot"), "unknown ml preset"),
+    (dict(kind="matsuoka", preset="run"), "unknown matsuoka preset"),
+    (dict(kind="hopf", preset="walk", weights=(0, 0, 0)), "Morris-Lecar"),
+    (dict(kind="ml", preset="walk", seed=-5), "non-negative"),
+    (dict(kind="ml", preset="walk", weights=(np.nan, 0, 0)), "NaN"),
+])
+def test_build_bad_input(kw, msg):
+    with pytest.raises(InputError, match=msg):
+        build(**kw)
+
+
+def test_a_network_without_rhythm_says_so():
+    with pytest.raises(NotOscillatingError, match="does not oscillate"):
+        build("ml", "walk", i_app=0.0, weights=(0, 0, 0)).period()  # the cells rest
+
+
+def test_step_change_keeps_the_state_and_reaches_the_new_gait():
+    """The network integrates through a change of its parameters: identical to the unchanged
+    network before it, and phase-locked in the new gait after it (state carried across)."""
+    a, b = build("ml", "walk"), build("ml", "run")
+    at = 150.0
+    moved = a.outputs(900.0, to=b, schedule=Schedule.change(at))
+    plain = a.outputs(900.0)
+    before = moved.t_model < at
+    assert np.array_equal(moved.v[before], plain.v[before])
+    tail = moved.t_model > 600.0  # from the walk's state the run locks after ~300 units
+    assert classify(moved.t_model[tail], moved.v[tail])[0] == "run"
+    assert moved.v[moved.t_model >= at][0] == pytest.approx(plain.v[plain.t_model >= at][0])
+
+
+def test_ramp_matches_the_numpy_reference_and_blend():
+    a, b = build("ml", "jump"), build("ml", "hop")
+    sch = Schedule.change(20.0, 10.0)
+    k = simulate_ml(a.i_app, a.phi, a.W, a.y0, t_end=60.0, to=(b.i_app, b.phi, b.W),
+                    schedule=sch)
+    n = simulate_ml(a.i_app, a.phi, a.W, a.y0, t_end=60.0, to=(b.i_app, b.phi, b.W),
+                    schedule=sch, backend="numpy")
+    assert np.allclose(k.x, n.x, atol=1e-9)
+    mid = blend(a, b, 0.5)
+    assert mid.i_app == pytest.approx((a.i_app + b.i_app) / 2)
+    assert np.allclose(mid.W, (a.W + b.W) / 2)
+    assert sch.at([0.0, 25.0, 30.0, 99.0]).tolist() == [0.0, 0.5, 1.0, 1.0]
+    assert Schedule.change(5.0).at([4.99, 5.0]).tolist() == [0.0, 1.0]
+
+
+def test_schedule_bad_input():
+    with pytest.raises(InputError, match="ramp"):
+        Schedule.change(1.0, -2.0)
+    with pytest.raises(InputError, match="sorted"):
+        Schedule((2.0, 1.0), (0.0, 1.0))
+    with pytest.raises(InputError, match="cannot change into"):
+        build("ml", "walk").outputs(10.0, to=build("hopf", "walk"), schedule=Schedule.change(1))
+
+
+def test_a_rhythm_that_misses_cells_is_no_rhythm():
+    """With I_app = 0 and the walk's weights two cells oscillate and two sit far below their
+    range: no four-cell rhythm to drive the ankles."""
+    with pytest.raises(NotOscillatingError, match="every cell"):
+        build("ml", "walk", i_app=0.0).period()

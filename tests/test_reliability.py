@@ -1,0 +1,323 @@
+"""Reliability: results all-or-nothing under Ctrl-C, one run per output folder, videos in
+bounded memory, and one line (never a traceback) for every bad input."""
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import time
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from cpg import outdir
+from envs.cli import main
+
+OPT = ["optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--quiet"]
+VOLATILE = ("wall_s", "resumed_from_generation")  # timing: differs between identical runs
+
+
+def snapshot(folder) -> dict:
+    """File name -> content digest (JSON without its timing fields)."""
+    out = {}
+    for f in sorted(os.listdir(folder)):
+        data = open(os.path.join(folder, f), "rb").read()
+        if f.endswith(".json"):
+            d = json.loads(data)
+            for k in VOLATILE:
+                d.pop(k, None)
+            data = json.dumps(d, sort_keys=True).encode()
+        out[f] = hashlib.sha256(data).hexdigest()
+    return out
+
+
+NOTES = "a file of the user's that no run writes: it must survive every swap\n"
+
+
+@pytest.fixture(scope="module")
+def old_and_new(tmp_path_factory):
+    """The complete result sets of two optimize runs (seeds 1 and 2) into folders that also
+    hold a file of the user's (notes.txt, carried over by the commit)."""
+    base = tmp_path_factory.mktemp("sets")
+    sets = {}
+    for seed in (1, 2):
+        d = base / f"seed{seed}"
+        d.mkdir()
+        (d / "notes.txt").write_text(NOTES)
+        assert main(OPT + ["--seed", str(seed), "--out", str(d)]) == 0
+        sets[seed] = snapshot(d)
+    assert sets[1] != sets[2] and set(sets[1]) == set(sets[2])
+    assert "notes.txt" in sets[1]
+    return sets
+
+
+def fresh_old_folder(tmp_path, old_and_new):
+    d = tmp_path / "res"
+    d.mkdir()
+    (d / "notes.txt").write_text(NOTES)
+    assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    assert snapshot(d) == old_and_new[1]
+    return d
+
+
+class Interrupt:
+    """Raise KeyboardInterrupt at the k-th call of a file operation."""
+
+    def __init__(self, real, k):
+        self.real, self.k, self.calls = real, k, 0
+
+    def __call__(self, *a, **kw):
+        self.calls += 1
+        if self.calls == self.k:
+            raise KeyboardInterrupt
+        return self.real(*a, **kw)
+
+
+@pytest.mark.parametrize("op", ["replace", "link"])
+def test_ctrl_c_at_every_write_leaves_the_old_or_the_new_set(tmp_path, old_and_new, monkeypatch,
+                                                             op):
+    """Interrupt optimize at each file rename (every result file and the final swap) and at each
+    link of the commit, in a folder that holds an earlier result: afterwards the folder holds
+    the complete old set or the complete new set, file by file, and the next run succeeds."""
+    d = fresh_old_folder(tmp_path, old_and_new)
+    real = getattr(os, op)
+    seen_new = seen_old = 0
+    for k in range(1, 40):
+        trap = Interrupt(real, k)
+        monkeypatch.setattr(os, op, trap)
+        code = main(OPT + ["--seed", "2", "--out", str(d)])
+        monkeypatch.setattr(os, op, real)
+        outdir.recover(d)  # what the next run does first
+        state = snapshot(d)
+        assert state in (old_and_new[1], old_and_new[2]), (k, code)
+        if code == 0:  # k passed every call of this kind: the run completed
+            assert state == old_and_new[2] and trap.calls < k
+            break
+        assert code == 130
+        seen_new += state == old_and_new[2]
+        seen_old += state == old_and_new[1]
+        if state == old_and_new[2]:  # put the old set back for the next interrupt point
+            assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    else:
+        pytest.fail("the run never completed")
+    assert seen_old > 0  # some interrupts came before the swap
+    assert main(OPT + ["--seed", "2", "--out", str(d)]) == 0 and snapshot(d) == old_and_new[2]
+
+
+def test_ctrl_c_by_signal_at_many_moments(tmp_path, old_and_new):
+    """SIGINT to a real process at moments spread over a run: old or new set, never mixed."""
+    d = fresh_old_folder(tmp_path, old_and_new)
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "envs.cli", *OPT, "--seed", "2", "--out", str(d)],
+                       capture_output=True, timeout=300)
+    total = time.perf_counter() - t0
+    assert r.returncode == 0
+    assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    for frac in np.linspace(0.3, 1.0, 8):
+        p = subprocess.Popen([sys.executable, "-m", "envs.cli", *OPT, "--seed", "2", "--out",
+                              str(d)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        time.sleep(frac * total)
+        p.send_signal(2)
+        p.wait(timeout=60)
+        outdir.recover(d)
+        assert snapshot(d) in (old_and_new[1], old_and_new[2]), frac
+        if snapshot(d) == old_and_new[2]:
+            assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+
+
+def test_two_runs_into_one_folder_one_fails_with_one_line(tmp_path):
+    d = tmp_path / "both"
+    procs = [subprocess.Popen([sys.executable, "-m", "envs.cli", *OPT, "--seed", str(s), "--out",
+                               str(d)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              text=True) for s in (3, 4)]
+    results = [(p.wait(timeout=300), p.stderr.read()) for p in procs]
+    codes = sorted(c for c, _ in results)
+    assert codes == [0, 2], results
+    err = next(e for c, e in results if c == 2).strip().splitlines()
+    assert len(err) == 1 and "another cpgbiped run is writing" in err[0]
+
+
+def test_a_failed_run_does_not_block_the_next(tmp_path):
+    """No feasible point (a box where no weight set reaches the hop): one line, no folder, no
+    checkpoint left; the next run in that folder succeeds."""
+    d = tmp_path / "f"
+    r = subprocess.run([sys.executable, "-m", "envs.cli", *OPT, "--bounds", "-1", "-0.9",
+                        "--out", str(d)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2 and "no feasible solution" in r.stderr, r.stderr
+    assert not d.exists()
+    assert not [p for p in tmp_path.iterdir() if "checkpoint" in p.name]
+    assert main(OPT + ["--out", str(d)]) == 0
+
+
+def test_checkpoint_header_is_checked_before_unpickling(tmp_path):
+    """A valid pickle without the header, or with another run's settings, is refused without
+    being unpickled (unpickling would run its code)."""
+    import pickle
+
+    from cpg.optimize import CHECKPOINT_MAGIC, load_checkpoint
+
+    ran = tmp_path / "ran"
+
+    class Evil:
+        def __reduce__(self):
+            return (os.mkdir, (str(ran),))
+
+    bare = tmp_path / "bare.pkl"
+    bare.write_bytes(pickle.dumps(Evil()))
+    with pytest.raises(Exception, match="no header"):
+        load_checkpoint(bare, {"n_var": 3})
+    other = tmp_path / "other.pkl"
+    other.write_bytes(CHECKPOINT_MAGIC + b"\n2\n{\"n_var\":9}\n" + pickle.dumps(Evil()))
+    with pytest.raises(Exception, match="other settings"):
+        load_checkpoint(other, {"n_var": 3})
+    wrong = tmp_path / "wrong.pkl"  # right header, a valid pickle of the wrong shape
+    wrong.write_bytes(CHECKPOINT_MAGIC + b"\n2\n{\"n_var\":3}\n" + pickle.dumps([1, 2, 3]))
+    with pytest.raises(Exception, match="does not hold an NSGA-II run"):
+        load_checkpoint(wrong, {"n_var": 3})
+    assert not ran.exists()
+
+
+def test_render_memory_does_not_grow_with_length():
+    """Frames are streamed to the encoder: the peak of Python-tracked memory while rendering 20x
+    more frames stays within a small bound of the short video's (holding the frames would add
+    160 x 120 x 3 bytes per frame, about 34 MB for the long one)."""
+    from cpg.network import build
+    from envs.render import render_video
+    from envs.rollout import rollout
+
+    rec = rollout(build("ml", "walk"), 6.0, stop_on_fall=False)
+    peaks = []
+    for seconds, fps in ((1.0, 30.0), (6.0, 100.0)):
+        out = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"cpgbiped_mem_{os.getpid()}.mp4")
+        tracemalloc.start()
+        render_video(rec, out, fps, 160, 120, seconds)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        os.unlink(out)
+    frames_long = 600
+    assert peaks[1] - peaks[0] < 0.1 * frames_long * 160 * 120 * 3, peaks
+
+
+def _bad_inputs(tmp):
+    """(arguments, expected text) for every input of the reliability issue, plus the bounds."""
+    folder = tmp / "a_folder"
+    blocker = tmp / "a_file"  # a path under a regular file cannot be written, even as root
+    empty = tmp / "empty_pareto.json"
+    ckpt_target = tmp / "ck"
+    return [
+        *[([cmd, *extra, "--seed", "-1"], "argument --seed") for cmd, extra in (
+            ("validate", []), ("render", ["--out", "v.mp4"]), ("log", ["--rrd", "l.rrd"]),
+            ("matrix", []), ("optimize", []), ("secondary", []), ("matsuoka", []),
+            ("hopf", []))],
+        (["validate", "--push", "inf", "10"], "argument --push"),
+        (["validate", "--push", "30", "10"], "outside the rollout"),
+        (["validate", "--seconds", "1e12"], "argument --seconds"),
+        (["hopf", "--seconds", "nan"], "argument --seconds"),
+        (["render", "--fps", "0.01", "--out", "v.mp4"], "less than one frame"),
+        (["render", "--fps", "1e9", "--seconds", "2", "--out", "v.mp4"], "fps"),
+        (["render", "--width", "100000", "--height", "100000", "--out", "v.mp4"],
+         "off-screen buffer"),
+        (["render", "--seconds", "601", "--out", "v.mp4"], "argument --seconds"),
+        (["render", "--out", "v.mp4", "--rrd", "x.txt"], "--rrd must name a .rrd file"),
+        (["render", "--out", str(folder)], "--out must name a .mp4"),
+        (["render", "--out", str(folder) + ".mp4"], "names a folder"),
+        (["log", "--rrd", str(blocker / "x.rrd")], "--rrd: cannot write"),
+        (["validate", "--rrd", str(folder) + ".rrd"], "names a folder"),
+        (["check-pareto", str(empty), "--out", "chk"], "holds no Pareto points"),
+        (["check-pareto", str(empty), "--out", str(blocker / "sub")], "--out: cannot write"),
+        (["optimize", "--out", str(blocker / "sub")], "--out: cannot write"),
+        (["optimize", "--out", str(blocker)], "names a file"),
+        (["optimize", "--gait", "hop", "--pop", "1000", "--gens", "2000", "--out", "o"],
+         "population x generations"),
+        (["optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--out", str(ckpt_target)],
+         "does not hold an NSGA-II run"),
+        (["demo", "--video-seconds", "0"], "argument --video-seconds"),
+        (["matrix", "--network", "ml", "--seconds", "0"], "argument --seconds"),
+    ]
+
+
+def test_every_bad_input_is_one_line_and_leaves_nothing(tmp_path):
+    import pickle
+
+    from cpg.optimize import CHECKPOINT_MAGIC, CHECKPOINT_VERSION
+    from cpg.outdir import ResultDir
+
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "a_folder").mkdir()
+    (work / "a_folder.mp4").mkdir()
+    (work / "a_folder.rrd").mkdir()
+    (work / "a_file").write_text("x")
+    (work / "empty_pareto.json").write_text(json.dumps({
+        "format": "cpgbiped.optimize/1", "gait": "walk", "i_app": 0.229, "phi": 0.254,
+        "chosen": {"weights": [0.39, -0.681, 0.489]}, "pareto": []}))
+    # A checkpoint with this run's header that unpickles to the wrong shape (a list).
+    from cpg.evaluate import SimSettings
+    from cpg.optimize import PrimaryGaitProblem, _meta_line
+    from dataclasses import asdict
+
+    pr = PrimaryGaitProblem("hop")
+    meta = {"problem": "PrimaryGaitProblem", "gait": "hop", "n_var": 3, "n_obj": 3,
+            "xl": pr.xl.tolist(), "xu": pr.xu.tolist(), "pop": 8, "gens": 2, "seed": 0,
+            "settings": asdict(SimSettings())}
+    state = ResultDir(work / "ck").state("hop.checkpoint.pkl")
+    state.write_bytes(CHECKPOINT_MAGIC + b"\n" + str(CHECKPOINT_VERSION).encode() + b"\n"
+                      + _meta_line(meta) + b"\n" + pickle.dumps([1, 2, 3]))
+    before = sorted(os.listdir(work))
+    for args, msg in _bad_inputs(work):
+        r = subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+                           text=True, timeout=300, cwd=work)
+        lines = r.stderr.strip().splitlines()
+        assert r.returncode in (1, 2), (args, r.stderr)
+        assert len(lines) == 1 and lines[0].startswith("cpgbiped: "), (args, r.stderr)
+        assert msg in lines[0], (args, lines[0])
+        assert "Traceback" not in r.stderr
+        after = sorted(p for p in os.listdir(work) if not p.endswith(".lock"))
+        assert after == before, (args, set(after) ^ set(before))
+
+
+def test_an_unexpected_error_is_one_line_with_exit_1(monkeypatch, capsys):
+    """The last-resort handler: any exception that is not bad input becomes one line, exit 1;
+    --debug (anywhere on the line) adds the traceback."""
+    import envs.cli as cli
+
+    def boom(a):
+        raise RuntimeError("something broke\non two lines")
+
+    real = cli.build_parser
+
+    def parser_with_a_bug():
+        p = real()
+        parse = p.parse_args
+
+        def parse_args(argv):
+            a = parse(argv)
+            a.func = boom
+            return a
+
+        p.parse_args = parse_args
+        return p
+
+    monkeypatch.setattr(cli, "build_parser", parser_with_a_bug)
+    assert cli.main(["reproduce"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["cpgbiped: internal error: RuntimeError: something broke on two lines "
+                   "(run again with --debug for the traceback)"]
+    assert cli.main(["reproduce", "--debug"]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" in err and err.strip().splitlines()[-1].startswith("cpgbiped: internal")
+
+
+def test_broken_mjcf_message_keeps_the_line_number(tmp_path):
+    from cpg.errors import InputError
+    from envs.biped import load_physics
+
+    bad = tmp_path / "broken.xml"
+    bad.write_text("<mujoco>\n<worldbody>\n<body>\n</mujoco>\n")
+    with pytest.raises(InputError) as e:
+        load_physics(bad)
+    import re
+
+    # tinyxml names the line of the element left open (<body>, line 3)
+    assert re.search(r"Line number=3\b", str(e.value)) and "\n" not in str(e.value)
