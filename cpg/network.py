@@ -239,22 +239,24 @@ class HopfPreset:
 
 # The primary gaits of the Hopf network. The lags are those of the gait table (every cell in
 # the phase the Morris-Lecar preset of that gait reaches); beta (the fraction of the cycle in
-# the "stance" half, y > 0, i.e. the burst) and the cycle time follow the Morris-Lecar presets
-# at ML_UNITS_PER_S: burst fractions of the extensor cells about 0.3 (walk, run), 0.4 (jump,
-# hop), cycles of about 1.0, 0.68, 0.92 and 0.61 s.
-def _hopf(lags, beta, period_s):
+# the "stance" half, y > 0, i.e. the burst) follows the Morris-Lecar presets' burst fractions
+# (about 0.3 for walk and run, 0.4 for jump and hop), and the cycle time is the Morris-Lecar
+# preset's period (Table 2 weights, `cpgbiped reproduce`) at ML_UNITS_PER_S, so that the two
+# networks ask the body for the same cadences: 13.113, 8.868, 11.985 and 7.918 model units,
+# i.e. 0.672, 0.455, 0.615 and 0.406 s.
+ML_TABLE2_PERIODS = {"walk": 13.113, "run": 8.868, "jump": 11.985, "hop": 7.918}
+
+
+def _hopf(gait, beta):
     # period = pi / omega_st + pi / omega_sw = (pi / omega_sw) / (1 - beta)  (large-a limit)
+    period_s = ML_TABLE2_PERIODS[gait] / ML_UNITS_PER_S
     omega_sw = np.pi / ((1.0 - beta) * period_s)
-    return HopfPreset(lags, hopf_mod.HopfParams(beta=beta, omega_sw=omega_sw, normalised=True,
-                                                k=2.0))
+    return HopfPreset(hopf_mod.GAIT_LAGS[gait], hopf_mod.HopfParams(
+        beta=beta, omega_sw=omega_sw, normalised=True, k=2.0))
 
 
-HOPF_PRESETS = {
-    "walk": _hopf(hopf_mod.GAIT_LAGS["walk"], 0.35, 1.0),
-    "run": _hopf(hopf_mod.GAIT_LAGS["run"], 0.35, 0.68),
-    "jump": _hopf(hopf_mod.GAIT_LAGS["jump"], 0.4, 0.92),
-    "hop": _hopf(hopf_mod.GAIT_LAGS["hop"], 0.4, 0.61),
-}
+HOPF_PRESETS = {"walk": _hopf("walk", 0.35), "run": _hopf("run", 0.35),
+                "jump": _hopf("jump", 0.4), "hop": _hopf("hop", 0.4)}
 
 
 class HopfNetwork(Network):

@@ -51,6 +51,13 @@ def test_hopf_period_is_the_analytic_one():
         assert build("hopf", g).period() == pytest.approx(hp.params.period, rel=0.05)
 
 
+def test_hopf_presets_ask_for_the_morris_lecar_cadences():
+    """Each Hopf preset cycles at the period, in seconds, of the Morris-Lecar preset of the same
+    gait (Table 2 weights at the one ML time unit), measured on both networks."""
+    for g in HOPF_PRESETS:
+        assert build("hopf", g).period_s() == pytest.approx(build("ml", g).period_s(), rel=0.05)
+
+
 def test_hopf_compiled_equals_numpy_reference():
     p = hopf.HopfParams(normalised=True, k=2.0, beta=0.4)
     y0 = hopf.random_states(4, 1, 5)[0]
