@@ -23,7 +23,7 @@ from numba import njit
 SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
-           "kp_air", "kd_knee", "push")
+           "kp_air", "kd_knee", "push", "swing_rest")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -100,8 +100,6 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
     for i in range(2):
         e[i] = a[2 + i]
         f[i] = a[i]
-    for i in range(2):  # swing drive: own flexor or the other leg's extensor (crossed)
-        g[i] = (1.0 - e[i]) * _clip01(w_flex * f[i] + w_cross * e[1 - i])
     # CPG features in [0, 1], from running averages <.> (time constant TAU_FEATURE):
     # sigma = <e_L e_R> / sqrt(<e_L^2> <e_R^2>)  (left-right synchrony of the extensors),
     # kappa = <f_L e_L + f_R e_R> / sqrt(<f_L^2 + f_R^2> <e_L^2 + e_R^2>)  (co-activation).
@@ -128,9 +126,14 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
         q = N_SHARED + 4 * n
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
-     knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push) = (
+     knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
+     swing_rest) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
-        G[14], G[15], G[16], G[17], G[18], G[19])
+        G[14], G[15], G[16], G[17], G[18], G[19], G[20])
+    # Swing drive: own flexor, the other leg's extensor (crossed), or the silence of the own
+    # extensor alone (swing_rest), all while the own extensor is silent.
+    for i in range(2):
+        g[i] = (1.0 - e[i]) * _clip01(w_flex * f[i] + w_cross * e[1 - i] + swing_rest)
     kp_knee = max(0.0, kp_knee)
     kp_push = max(0.0, kp_push)
     kp_air = max(0.0, kp_air)

@@ -11,9 +11,10 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    the network's fixed time unit (:mod:`cpg.network`). The schedule holds the raw outputs v
    and the activations a = network.activation(v) in [0, 1] of the cells LF, RF, LE, RE.
    Per leg i (j the other leg): flexor f_i = a_iF, extensor e_i = a_iE,
-   - swing drive     g_i = (1 - e_i) clip(w_flex f_i + w_cross e_j, 0, 1)
+   - swing drive     g_i = (1 - e_i) clip(w_flex f_i + w_cross e_j + swing_rest, 0, 1)
      (the leg's own flexor burst, or the other leg's extensor burst - a crossed extension -
-     while its own extensor is silent),
+     or, by the blended swing_rest, the mere silence of its own extensor: the leg stays
+     tucked until its next burst, which is when it lands),
    - stance command  e_i >= e_on,
    and two features of the rhythm, measured online from the CPG signals (<.> running averages
    with a time constant of 0.5 s), both in [0, 1]:
@@ -112,6 +113,7 @@ class Corner:
     kp_air: float = 1.007  # ... in the air and lifting
     kd_knee: float = 0.1
     push: float = 0.9162  # knee extension torque per unit of burst drive
+    swing_rest: float = 0.0  # swing drive while the leg's own extensor is silent
 
 
 @dataclass(frozen=True)
@@ -131,11 +133,11 @@ class ControlParams:
         knee_land=-0.356837, kp_knee=1.65299, kp_push=0.862569, kp_air=3.36174,
         kd_knee=0.0426775, push=0.241425)  # sigma = 0, kappa = 0
     alternating_coactive: Corner = Corner(
-        k_ax=10.562, k_av=3.4941, kp_t=3.74667, kd_t=0.570752, pitch_d=0.0875772,
-        theta0=0.004821, c_v=0.406405, c_d=0.527345, kp_sw=1.35279, kd_sw=0.23361,
-        kf_t=0.0241645, knee_ext=-0.606263, knee_crouch=-0.473625, knee_swing=-0.975398,
-        knee_land=-0.624593, kp_knee=4.78708, kp_push=4.31312, kp_air=4.74115,
-        kd_knee=0.15244, push=0.811227)  # sigma = 0, kappa = 1
+        k_ax=23.8132, k_av=0.747224, kp_t=5.87368, kd_t=0.627842, pitch_d=0.225303,
+        theta0=0.471605, c_v=0.0471514, c_d=0.529637, kp_sw=1.06077, kd_sw=0.0502182,
+        kf_t=-0.120347, knee_ext=-0.453588, knee_crouch=-0.303723, knee_swing=-0.687485,
+        knee_land=-0.297439, kp_knee=1.07469, kp_push=1.45257, kp_air=0.891943, kd_knee=0.101903,
+        push=0.523803, swing_rest=0.00565003)  # sigma = 0, kappa = 1
     synchronous: Corner = Corner(
         k_ax=15.405, k_av=1.65213, kp_t=3.79622, kd_t=0.499886, pitch_d=0.250948,
         theta0=0.0418366, c_v=0.21664, c_d=0.16645, kp_sw=3.84253, kd_sw=0.0300601,

@@ -34,7 +34,7 @@ CORNER_SPACE = dict(
     kp_sw=(0.3, 4.0), kd_sw=(0.02, 0.4), kf_t=(-1.0, 1.0), knee_ext=(-0.9, 0.0),
     knee_crouch=(-1.0, -0.05), knee_swing=(-1.4, -0.2), knee_land=(-0.9, 0.0),
     kp_knee=(0.3, 5.0), kp_push=(0.1, 5.0), kp_air=(0.3, 5.0), kd_knee=(0.02, 0.3),
-    push=(0.0, 1.0),
+    push=(0.0, 1.0), swing_rest=(0.0, 1.0),
 )
 # ... and of the shared parameters ("units_per_s": the Morris-Lecar time unit).
 SHARED_SPACE = dict(ankle_gain=(0.05, 1.0), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
