@@ -133,11 +133,11 @@ class ControlParams:
         knee_land=-0.356837, kp_knee=1.65299, kp_push=0.862569, kp_air=3.36174,
         kd_knee=0.0426775, push=0.241425)  # sigma = 0, kappa = 0
     alternating_coactive: Corner = Corner(
-        k_ax=23.8132, k_av=0.747224, kp_t=5.87368, kd_t=0.627842, pitch_d=0.225303,
-        theta0=0.471605, c_v=0.0471514, c_d=0.529637, kp_sw=1.06077, kd_sw=0.0502182,
-        kf_t=-0.120347, knee_ext=-0.453588, knee_crouch=-0.303723, knee_swing=-0.687485,
-        knee_land=-0.297439, kp_knee=1.07469, kp_push=1.45257, kp_air=0.891943, kd_knee=0.101903,
-        push=0.523803, swing_rest=0.00565003)  # sigma = 0, kappa = 1
+        k_ax=23.8134, k_av=0.746165, kp_t=5.8726, kd_t=0.63193, pitch_d=0.26403, theta0=0.471598,
+        c_v=0.0445525, c_d=0.529711, kp_sw=1.2997, kd_sw=0.0631488, kf_t=-0.0997662,
+        knee_ext=-0.443033, knee_crouch=-0.303713, knee_swing=-0.679225, knee_land=-0.315828,
+        kp_knee=1.07473, kp_push=1.50687, kp_air=0.885357, kd_knee=0.101894, push=0.555107,
+        swing_rest=0.144525)  # sigma = 0, kappa = 1
     synchronous: Corner = Corner(
         k_ax=15.405, k_av=1.65213, kp_t=3.79622, kd_t=0.499886, pitch_d=0.250948,
         theta0=0.0418366, c_v=0.21664, c_d=0.16645, kp_sw=3.84253, kd_sw=0.0300601,
