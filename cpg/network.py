@@ -51,6 +51,10 @@ ML_UNITS_PER_S = 19.5
 ML_V_HALF, ML_V_WIDTH = 0.0, 0.04  # activation map of a Morris-Lecar cell (voltage units)
 HOPF_WIDTH = 0.1  # activation map of a Hopf oscillator (units of y)
 MATSUOKA_PEAK = 4.0  # usual peak output of a calibrated ankle neuron (r = 8)
+# Half-activation of a Matsuoka ankle neuron, as a fraction of that peak: at 0.6 the extensor
+# neurons' bursts (activation > 0.5) cover about a third of the cycle (0.34) and the flexors'
+# 0.2, close to the Morris-Lecar cells' 0.3; at 0.5 the extensors covered 0.46 of it.
+MATSUOKA_HALF = 0.6
 MATSUOKA_ANKLE = (5, 11, 4, 10)  # neurons L ankle flex, R ankle flex, L ankle ext, R ankle ext
 
 
@@ -326,7 +330,7 @@ class MatsuokaNetwork(Network):
 
     def activation(self, v):
         v = np.asarray(v, dtype=float)
-        return _sigmoid((v - 0.5 * MATSUOKA_PEAK) / (0.08 * MATSUOKA_PEAK))
+        return _sigmoid((v - MATSUOKA_HALF * MATSUOKA_PEAK) / (0.08 * MATSUOKA_PEAK))
 
     def params(self):
         return {"tau": self.p.tau, "T": self.p.T, "beta": self.p.beta, "r": self.p.r,
