@@ -145,11 +145,11 @@ class ControlParams:
         knee_swing=-0.394472, knee_land=-0.219799, kp_knee=2.21419, kp_push=4.89344,
         kp_air=2.43328, kd_knee=0.0536399, push=0.20081)  # sigma = 1, kappa = 0
     synchronous_coactive: Corner = Corner(
-        k_ax=5.94787, k_av=1.24936, kp_t=1.09869, kd_t=0.234526, pitch_d=0.27974, theta0=0.438792,
-        c_v=0.0678697, c_d=0.967254, kp_sw=1.34222, kd_sw=0.341359, kf_t=-0.672829,
-        knee_ext=-0.0827326, knee_crouch=-0.348182, knee_swing=-0.562521, knee_land=-0.0546675,
-        kp_knee=2.33046, kp_push=4.86761, kp_air=0.376633, kd_knee=0.0467338, push=0.702985,
-        swing_rest=0.0863385)  # sigma = 1, kappa = 1
+        k_ax=5.90868, k_av=1.58275, kp_t=1.50385, kd_t=0.275735, pitch_d=0.279891,
+        theta0=0.397773, c_v=0.0864528, c_d=0.996794, kp_sw=1.60319, kd_sw=0.332139,
+        kf_t=-0.679629, knee_ext=-0.0549272, knee_crouch=-0.329633, knee_swing=-0.566984,
+        knee_land=-2.85421e-05, kp_knee=2.14458, kp_push=4.96904, kp_air=0.376679,
+        kd_knee=0.0489101, push=0.648257, swing_rest=0.0651066)  # sigma = 1, kappa = 1
 
     def corner(self, name: str) -> Corner:
         return getattr(self, name)
