@@ -145,11 +145,11 @@ class ControlParams:
         knee_swing=-0.394472, knee_land=-0.219799, kp_knee=2.21419, kp_push=4.89344,
         kp_air=2.43328, kd_knee=0.0536399, push=0.20081)  # sigma = 1, kappa = 0
     synchronous_coactive: Corner = Corner(
-        k_ax=5.90868, k_av=1.58275, kp_t=1.50385, kd_t=0.275735, pitch_d=0.279891,
-        theta0=0.397773, c_v=0.0864528, c_d=0.996794, kp_sw=1.60319, kd_sw=0.332139,
-        kf_t=-0.679629, knee_ext=-0.0549272, knee_crouch=-0.329633, knee_swing=-0.566984,
-        knee_land=-2.85421e-05, kp_knee=2.14458, kp_push=4.96904, kp_air=0.376679,
-        kd_knee=0.0489101, push=0.648257, swing_rest=0.0651066)  # sigma = 1, kappa = 1
+        k_ax=0.592679, k_av=4.5132, kp_t=4.11062, kd_t=0.258228, pitch_d=0.197643,
+        theta0=0.340126, c_v=0.211234, c_d=0.268493, kp_sw=3.13671, kd_sw=0.382845,
+        kf_t=-0.195603, knee_ext=-0.31993, knee_crouch=-0.472452, knee_swing=-0.634746,
+        knee_land=-0.159711, kp_knee=0.536043, kp_push=4.992, kp_air=3.6832,
+        kd_knee=0.0525718, push=0.793964)  # sigma = 1, kappa = 1
 
     def corner(self, name: str) -> Corner:
         return getattr(self, name)

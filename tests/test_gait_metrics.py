@@ -39,6 +39,16 @@ def test_known_gaits(period, duty, lag, want):
     assert m.physical_gait == want
 
 
+def test_one_leg_hopping_while_the_other_taps_is_not_a_hop():
+    """Both feet land together, flight 24%, mean duty 0.43: a hop by every other number, but the
+    left foot only taps (duty 0.11) while the right carries the stance (0.75)."""
+    c = np.stack([foot(0.4, 0.11, 0.0), foot(0.4, 0.75, 0.0)], axis=1)
+    m = gm.measure(T, c, 0.0 * T, settle_s=2.0)
+    assert m.duty_factor["left"] == pytest.approx(0.11, abs=0.01)
+    assert m.duty_factor["right"] == pytest.approx(0.75, abs=0.01)
+    assert m.physical_gait == "none"
+
+
 def test_flicker_is_debounced():
     c, x = series(1.0, 0.65, 0.5)
     rng = np.random.default_rng(0)

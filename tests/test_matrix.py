@@ -3,25 +3,52 @@
 The controller never sees the preset's name, so a diagonal matrix is the evidence that the
 CPG chooses the gait. 20 s after 2 s of settling, as the criteria.
 """
+import functools
+
 import pytest
 
 from cpg.errors import InputError
 from envs.criteria import WINDOW_S
 from envs.matrix import matrix, matrix_table
 
+PRESETS = ("walk", "run", "jump", "hop")
+# Rows the one controller does not reach yet (measured; README "Status"); strict, so that a
+# row that starts passing is noticed.
+KNOWN_SHORTFALLS = {
+}
 
-@pytest.mark.parametrize("kind", ["ml", "hopf"])
-def test_matrix_is_diagonal(kind):
-    res = matrix(kind, seconds=WINDOW_S)
-    assert res["network"] == kind and set(res["rows"]) == {"walk", "run", "jump", "hop"}
-    for preset, row in res["rows"].items():
-        assert not row["fell"], (preset, row)
-        assert row["physical_gait"] == preset, (preset, row)
-    assert "4 of 4 presets give their own physical gait" in matrix_table(res)
+
+@functools.cache
+def cached(kind: str) -> dict:
+    return matrix(kind, seconds=WINDOW_S)
+
+
+def _cases():
+    for kind in ("ml", "hopf"):
+        for preset in PRESETS:
+            why = KNOWN_SHORTFALLS.get(f"{kind}-{preset}")
+            marks = [pytest.mark.xfail(strict=True, reason=why)] if why else []
+            yield pytest.param(kind, preset, id=f"{kind}-{preset}", marks=marks)
+
+
+@pytest.mark.parametrize("kind,preset", list(_cases()))
+def test_matrix_row_is_its_own_gait(kind, preset):
+    """Each preset, driving the body through the one controller, gives its own physical gait
+    without a fall."""
+    row = cached(kind)["rows"][preset]
+    assert not row["fell"], row
+    assert row["physical_gait"] == preset, row
+
+
+def test_matrix_table_counts_the_diagonal():
+    res = cached("ml")
+    assert res["network"] == "ml" and set(res["rows"]) == set(PRESETS)
+    diag = sum(r["physical_gait"] == p for p, r in res["rows"].items())
+    assert f"{diag} of 4 presets give their own physical gait" in matrix_table(res)
 
 
 def test_matsuoka_network_walks():
-    row = matrix("matsuoka", seconds=WINDOW_S)["rows"]["walk"]
+    row = cached("matsuoka")["rows"]["walk"]
     assert not row["fell"] and row["physical_gait"] == "walk", row
 
 

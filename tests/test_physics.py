@@ -42,8 +42,22 @@ def others_for(gait: str, cond: dict) -> dict:
     return {g: summary(g, **cond) for g in refs}
 
 
-@pytest.mark.parametrize("cond", CONDITIONS, ids=CONDITION_IDS)
-@pytest.mark.parametrize("gait", GAITS)
+# What the one controller does not reach yet (measured; README "Status"). Each stays a test of
+# the full criteria and is expected to fail; strict, so that a case that starts passing is
+# noticed and moved out of this list.
+KNOWN_SHORTFALLS = {
+}
+
+
+def _cases():
+    for gait in GAITS:
+        for cond, cid in zip(CONDITIONS, CONDITION_IDS):
+            why = KNOWN_SHORTFALLS.get(f"{gait}-{cid}")
+            marks = [pytest.mark.xfail(strict=True, reason=why)] if why else []
+            yield pytest.param(gait, cond, id=f"{gait}-{cid}", marks=marks)
+
+
+@pytest.mark.parametrize("gait,cond", list(_cases()))
 def test_table2_network_meets_its_criteria(gait, cond):
     """Walk, run, jump and hop each meet every criterion with the one controller; both
     classifiers name the gait (part of the failures list)."""
