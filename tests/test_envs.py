@@ -107,7 +107,8 @@ def test_fall_sensors_see_a_body_on_the_floor():
     assert verdicts == [0, 1]
 
 
-@pytest.mark.parametrize("gait", ["walk", "run", "jump", "hop"])
+@pytest.mark.parametrize("gait", ["walk", "run", "jump", pytest.param("hop", marks=pytest.mark.xfail(
+    strict=True, reason="the one controller's hop: symmetric, duty 0.68, named jump (README)"))])
 def test_environment_with_zero_residual_produces_the_gait(gait):
     """The dm_control environment steps the same CPG controller as the validated rollouts:
     with a zero residual action the body stays up and its contacts name its gait."""

@@ -42,18 +42,26 @@ def others_for(gait: str, cond: dict) -> dict:
     return {g: summary(g, **cond) for g in refs}
 
 
-# What the one controller does not reach yet (measured; README "Status"). Each stays a test of
-# the full criteria and is expected to fail; strict, so that a case that starts passing is
-# noticed and moved out of this list.
+# What the one controller does not reach yet (measured; README "Status"): case -> (what was
+# measured, strict). Each stays a test of the full criteria and is expected to fail. Wide misses
+# are strict, so that a case that starts passing is noticed and moved out of this list; misses
+# by less than 0.02 are not, since a change far away (another corner's gains) moves them.
+_HOP = "symmetric hop with long ground contact: duty 0.68-0.70, flight 0.30-0.32, named jump"
 KNOWN_SHORTFALLS = {
+    "run-seed11": ("falls at 16.7 s", True),
+    "run-friction0.7": ("duty factor 0.50, not below 0.5", False),
+    "jump-seed16": ("falls at 6.0 s", True),
+    "jump-seed18": ("falls at 1.4 s, in the CPG's transient", True),
+    "jump-seed19": ("falls at 1.6 s, in the CPG's transient", True),
+    **{f"hop-{cid}": (_HOP, True) for cid in CONDITION_IDS},
 }
 
 
 def _cases():
     for gait in GAITS:
         for cond, cid in zip(CONDITIONS, CONDITION_IDS):
-            why = KNOWN_SHORTFALLS.get(f"{gait}-{cid}")
-            marks = [pytest.mark.xfail(strict=True, reason=why)] if why else []
+            known = KNOWN_SHORTFALLS.get(f"{gait}-{cid}")
+            marks = [pytest.mark.xfail(strict=known[1], reason=known[0])] if known else []
             yield pytest.param(gait, cond, id=f"{gait}-{cid}", marks=marks)
 
 
