@@ -25,6 +25,7 @@ temporary file and renamed.
 """
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,7 @@ from cpg.io import atomic_path, to_json
 from .gait_metrics import debounce, edges
 
 CELLS = ("LF", "RF", "LE", "RE")
+POSE_HZ = 100.0  # rate of the body's poses, force arrows and centre of mass in the 3D view
 LEGS = ("left", "right")
 FEET = ("left_foot", "right_foot")  # the model's foot bodies, in LEGS order
 JOINTS = tuple(f"{leg}_{j}" for leg in LEGS for j in ("hip", "knee", "ankle"))
@@ -53,10 +55,30 @@ def _columns(rec_stream, path: str, t: np.ndarray, x: np.ndarray):
                             columns=rr.Scalars.columns(scalars=np.asarray(x, dtype=float)))
 
 
+def _rotate_many(wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate the vector v (3,) by each unit quaternion (T, 4) = (w, x, y, z):
+    v' = v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)."""
+    w, u = wxyz[:, :1], wxyz[:, 1:]
+    uv = np.cross(u, v)
+    return v + 2.0 * w * uv + 2.0 * np.cross(u, uv)
+
+
+def _static_entities(xml_path) -> list:
+    """The model's geometry as rerun archetypes, built once per file and version."""
+    p = Path(xml_path)
+    return _static_entities_of(str(p.resolve()), p.stat().st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=8)
+def _static_entities_of(path: str, mtime_ns: int) -> list:
+    from . import record_body
+    from .biped import load_model
+
+    return record_body.static_entities(load_model(path))
+
+
 def _soles(model, pose: np.ndarray) -> dict:
     """Each foot's sole centre in the world per tick (the centre of its first geom, at z = 0)."""
-    import mujoco
-
     out = {}
     for leg, foot in zip(LEGS, FEET):
         try:
@@ -65,11 +87,7 @@ def _soles(model, pose: np.ndarray) -> dict:
             raise InputError(f"the model has no body {foot!r}: the recording needs the feet "
                              f"{', '.join(FEET)}") from None
         g = int(np.nonzero(model.geom_bodyid == b)[0][0])
-        sole = np.empty((len(pose), 3))
-        R = np.zeros(9)
-        for k in range(len(pose)):
-            mujoco.mju_quat2Mat(R, pose[k, b, 3:])
-            sole[k] = pose[k, b, :3] + R.reshape(3, 3) @ model.geom_pos[g]
+        sole = pose[:, b, :3] + _rotate_many(pose[:, b, 3:], model.geom_pos[g])
         sole[:, 2] = 0.0
         out[leg] = sole
     return out
@@ -113,13 +131,17 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
     if len(rec.body_pose):
         model = load_model(rec.xml_path)
         world = f"/{name}/world"
-        record_body.log_static(rs, world, model)
-        record_body.log_poses(rs, world, model, t, rec.body_pose)
+        # The 3D view at POSE_HZ (the time series keep every control tick): a viewer shows a
+        # few tens of frames per second, and the body's data dominate the recording's cost.
+        k = max(1, int(round(1.0 / (POSE_HZ * rec.dt))))
+        pose = rec.body_pose[::k]
+        record_body.log_static(rs, world, _static_entities(rec.xml_path))
+        record_body.log_poses(rs, world, model, t[::k], pose)
         weight = float(model.body_mass.sum() * -model.opt.gravity[2])
-        record_body.log_forces(rs, world, t, _soles(model, rec.body_pose), contact, rec.force,
-                               weight)
-        com = np.stack([rec.com_x, np.zeros_like(rec.com_x), rec.com_z], axis=1)
-        record_body.log_com(rs, world, t, com)
+        record_body.log_forces(rs, world, t[::k], _soles(model, pose), contact[::k],
+                               rec.force[::k], weight)
+        com = np.stack([rec.com_x, np.zeros_like(rec.com_x), rec.com_z], axis=1)[::k]
+        record_body.log_com(rs, world, t[::k], com)
     if metrics is not None:
         md = "```json\n" + to_json(metrics.as_dict() if hasattr(metrics, "as_dict") else metrics) + "\n```"
         rs.log(f"/{name}/metrics", rr.TextDocument(md, media_type="text/markdown"), static=True)

@@ -79,25 +79,34 @@ def _name(model, kind, i: int, prefix: str) -> str:
     return n if n else f"{prefix}{i}"
 
 
-def log_static(rs, root: str, model: mujoco.MjModel) -> None:
-    """Geometry of every body (in its frame) and the floor, once, as static data."""
+def static_entities(model: mujoco.MjModel) -> list:
+    """(path below the root, archetype) of every body geom (in its body's frame) and the
+    floor; build once per model and log with :func:`log_static`."""
     import rerun as rr
 
+    out = []
     for g in range(model.ngeom):
         b = model.geom_bodyid[g]
         if b == 0:
             if model.geom_type[g] == _GEOM.mjGEOM_PLANE:
                 half = model.geom_size[g].copy()
                 half[:2] = np.where(half[:2] > 0, half[:2], 50.0)
-                rs.log(f"{root}/floor/{_name(model, 'geom', g, 'geom')}",
-                       rr.Boxes3D(half_sizes=[[half[0], half[1], 0.002]],
-                                  centers=[model.geom_pos[g] - [0, 0, 0.002]],
-                                  colors=[[90, 100, 110, 255]], fill_mode="solid"), static=True)
+                out.append((f"floor/{_name(model, 'geom', g, 'geom')}",
+                            rr.Boxes3D(half_sizes=[[half[0], half[1], 0.002]],
+                                       centers=[model.geom_pos[g] - [0, 0, 0.002]],
+                                       colors=[[90, 100, 110, 255]], fill_mode="solid")))
             continue
         arch = geom_archetype(model, g)
         if arch is not None:
-            rs.log(f"{root}/body/{_name(model, 'body', b, 'body')}/{_name(model, 'geom', g, 'geom')}",
-                   arch, static=True)
+            out.append((f"body/{_name(model, 'body', b, 'body')}/{_name(model, 'geom', g, 'geom')}",
+                        arch))
+    return out
+
+
+def log_static(rs, root: str, entities: list) -> None:
+    """The geometry of :func:`static_entities`, once, as static data."""
+    for path, arch in entities:
+        rs.log(f"{root}/{path}", arch, static=True)
 
 
 def log_poses(rs, root: str, model: mujoco.MjModel, t: np.ndarray, pose: np.ndarray) -> None:
