@@ -36,7 +36,6 @@ from cpg.io import atomic_path, to_json
 from .gait_metrics import debounce, edges
 
 CELLS = ("LF", "RF", "LE", "RE")
-POSE_HZ = 100.0  # rate of the body's poses, force arrows and centre of mass in the 3D view
 LEGS = ("left", "right")
 FEET = ("left_foot", "right_foot")  # the model's foot bodies, in LEGS order
 JOINTS = tuple(f"{leg}_{j}" for leg in LEGS for j in ("hip", "knee", "ankle"))
@@ -131,17 +130,13 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
     if len(rec.body_pose):
         model = load_model(rec.xml_path)
         world = f"/{name}/world"
-        # The 3D view at POSE_HZ (the time series keep every control tick): a viewer shows a
-        # few tens of frames per second, and the body's data dominate the recording's cost.
-        k = max(1, int(round(1.0 / (POSE_HZ * rec.dt))))
-        pose = rec.body_pose[::k]
+        pose = rec.body_pose  # one pose per control tick
         record_body.log_static(rs, world, _static_entities(rec.xml_path))
-        record_body.log_poses(rs, world, model, t[::k], pose)
+        record_body.log_poses(rs, world, model, t, pose)
         weight = float(model.body_mass.sum() * -model.opt.gravity[2])
-        record_body.log_forces(rs, world, t[::k], _soles(model, pose), contact[::k],
-                               rec.force[::k], weight)
-        com = np.stack([rec.com_x, np.zeros_like(rec.com_x), rec.com_z], axis=1)[::k]
-        record_body.log_com(rs, world, t[::k], com)
+        record_body.log_forces(rs, world, t, _soles(model, pose), contact, rec.force, weight)
+        com = np.stack([rec.com_x, np.zeros_like(rec.com_x), rec.com_z], axis=1)
+        record_body.log_com(rs, world, t, com)
     if metrics is not None:
         md = "```json\n" + to_json(metrics.as_dict() if hasattr(metrics, "as_dict") else metrics) + "\n```"
         rs.log(f"/{name}/metrics", rr.TextDocument(md, media_type="text/markdown"), static=True)

@@ -114,10 +114,11 @@ def log_poses(rs, root: str, model: mujoco.MjModel, t: np.ndarray, pose: np.ndar
     import rerun as rr
 
     index = [rr.TimeColumn("sim_time", duration=t)]
+    xyzw = np.ascontiguousarray(pose[:, :, [4, 5, 6, 3]])  # rerun's quaternion order, all at once
     for b in range(1, model.nbody):
         rs.send_columns(f"{root}/body/{_name(model, 'body', b, 'body')}", indexes=index,
                         columns=rr.Transform3D.columns(translation=pose[:, b, :3],
-                                                       quaternion=_xyzw(pose[:, b, 3:])))
+                                                       quaternion=xyzw[:, b]))
 
 
 def log_forces(rs, root: str, t: np.ndarray, feet: dict, contact: np.ndarray,

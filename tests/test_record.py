@@ -47,33 +47,22 @@ def test_every_body_has_static_geometry(logged):
     assert t is None and floor
 
 
-def pose_ticks(rec) -> slice:
-    """The ticks the 3D view holds: every k-th, at POSE_HZ."""
-    from envs.record import POSE_HZ
-
-    k = max(1, int(round(1.0 / (POSE_HZ * rec.dt))))
-    assert 0.5 * POSE_HZ <= 1.0 / (k * rec.dt) <= 2.0 * POSE_HZ
-    return slice(None, None, k)
-
-
 def test_body_poses_match_the_simulation_within_1_mm(logged):
     """Recompute every body's position from the rollout's recorded joint positions (forward
-    kinematics in MuJoCo) and compare with the logged transforms, at every logged tick."""
+    kinematics in MuJoCo) and compare with the logged transforms, tick by tick."""
     rrd, v = logged
     rec = v.recording
-    ticks = pose_ticks(rec)
     m = load_model()
     d = mujoco.MjData(m)
-    qpos = rec.qpos[ticks]
-    want = np.empty((len(qpos), m.nbody, 3))
-    for k, q in enumerate(qpos):
+    want = np.empty((len(rec.t), m.nbody, 3))
+    for k, q in enumerate(rec.qpos):
         d.qpos[:] = q
         mujoco.mj_kinematics(m, d)
         want[k] = d.xpos
     for b in range(1, m.nbody):
         t, rows = read_component(rrd, f"/walk/world/body/{m.body(b).name}",
                                  "Transform3D:translation")
-        assert len(t) == len(qpos) and np.allclose(t, rec.t[ticks], atol=1e-9)
+        assert len(t) == len(rec.t) and np.allclose(t, rec.t, atol=1e-9)
         got = np.array([r[0] for r in rows])
         assert np.max(np.abs(got - want[:, b])) < 1e-3, m.body(b).name
 
@@ -83,16 +72,14 @@ def test_force_arrows_only_in_contact(logged):
     rec = v.recording
     for i, leg in enumerate(("left", "right")):
         t, rows = read_component(rrd, f"/walk/world/grf/{leg}", "Arrows3D:vectors")
-        ticks = pose_ticks(rec)
-        on = debounce(rec.contact[:, i], rec.dt)[ticks]
+        on = debounce(rec.contact[:, i], rec.dt)
         assert len(rows) == len(on)
         shown = np.array([bool(r) for r in rows])
         assert np.array_equal(shown, on)
         # Upward, the measured normal force at 0.5 m per body weight.
         weight = load_model().body_mass.sum() * 9.81
         lengths = np.array([r[0][2] for r in rows if r])
-        assert np.allclose(lengths, 0.5 * rec.force[ticks][on, i] / weight, rtol=1e-5,
-                           atol=1e-6)
+        assert np.allclose(lengths, 0.5 * rec.force[on, i] / weight, rtol=1e-5, atol=1e-6)
         assert np.mean(lengths) > 0.1
     t, states = read_component(rrd, "/walk/feet/left", "StateChange:state")
     assert set(s[0] for s in states) == {"stance", "swing"}
