@@ -164,9 +164,13 @@ def blueprint(rollouts: dict, videos: dict | None = None):
         follow = rrb.VisibleTimeRange("sim_time",
                                       start=rrb.TimeRangeBoundary.cursor_relative(seconds=-w),
                                       end=rrb.TimeRangeBoundary.cursor_relative(seconds=0.1 * w))
+        # The viewer opens at the end of the timeline, and the web viewer does not move the eye
+        # with tracking_entity until the user touches the view: aim at where the body ends.
+        x_end = float(rec.com_x[-1]) if len(rec.com_x) and np.isfinite(rec.com_x[-1]) else 0.0
         body = rrb.Spatial3DView(
             origin=f"/{n}/world", name=f"{n}: body",
-            eye_controls=rrb.EyeControls3D(position=[0.0, -3.2, 0.9], look_target=[0.0, 0.0, 0.6],
+            eye_controls=rrb.EyeControls3D(position=[x_end, -3.2, 0.9],
+                                           look_target=[x_end, 0.0, 0.6],
                                            eye_up=[0.0, 0.0, 1.0],
                                            tracking_entity=f"/{n}/world/body/torso"))
         left = [body] + ([rrb.Spatial2DView(origin=f"/{n}/video", name=f"{n}: video")]

@@ -40,10 +40,12 @@ def analyse(png: str) -> dict:
     busy = float(np.mean(np.linalg.norm(img.astype(float) - bg, axis=-1) > 30))
     loaded = n_colors > 60 and busy > 0.05
     # Body: the left column holds the 3D view; the legs are blue (left) and orange-red (right).
-    left = img[:, : int(0.55 * w)]
+    # Rows of the viewer's chrome (top bar with its orange warnings, bottom timeline with its
+    # blue buttons) are left out: they once passed an empty 3D view.
+    left = img[int(0.08 * h): int(0.9 * h), : int(0.55 * w)]
     blue = int(_hue_mask(left, 200, 235).sum())
     red = int(_hue_mask(left, 0, 30).sum())
-    body = blue > 200 and red > 200
+    body = blue > 1000 and red > 1000
     # Footfalls: the right column's lanes in the two feet's colours.
     right = img[:, int(0.6 * w):]
     lanes = {leg: int(_near(right, c, 40).sum()) for leg, c in FOOT_COLORS.items()}
