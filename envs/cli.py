@@ -107,26 +107,26 @@ def out_file(path: str | None, option: str, suffix: str) -> str | None:
         raise _input_error(f"{option} must name a {suffix} file, got {path!r}")
     if os.path.isdir(path):
         raise _input_error(f"{option} names a folder, not a {suffix} file: {path!r}")
-    folder = os.path.dirname(os.path.abspath(path))
+    _check_writable_ancestor(os.path.dirname(os.path.abspath(path)), path, option)
+    return path
+
+
+def _check_writable_ancestor(folder: str, path: str, option: str) -> None:
+    """The nearest existing folder at or above ``folder`` must be writable (``path`` is what
+    the user typed, for the message)."""
     probe = folder
     while not os.path.exists(probe):
         probe = os.path.dirname(probe)
     if not os.path.isdir(probe) or not os.access(probe, os.W_OK | os.X_OK):
-        raise _input_error(f"{option}: cannot write {path!r} ({probe!r} is not a writable "
+        raise _input_error(f"{option}: cannot write to {path!r} ({probe!r} is not a writable "
                            f"folder)")
-    return path
 
 
 def out_dir(path: str, option: str = "--out") -> str:
     """An output folder the user named: not a file, under a writable folder."""
     if os.path.exists(path) and not os.path.isdir(path):
         raise _input_error(f"{option} names a file, not a folder: {path!r}")
-    probe = os.path.abspath(path)
-    while not os.path.exists(probe):
-        probe = os.path.dirname(probe)
-    if not os.path.isdir(probe) or not os.access(probe, os.W_OK | os.X_OK):
-        raise _input_error(f"{option}: cannot write to {path!r} ({probe!r} is not a writable "
-                           f"folder)")
+    _check_writable_ancestor(os.path.abspath(path), path, option)
     return path
 
 
