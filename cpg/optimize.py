@@ -259,10 +259,13 @@ class RunResult:
     resumed_from: int | None = None
 
 
-def _algorithm(pop: int):
+def _algorithm(pop: int, sampling=None):
+    """NSGA-II; ``sampling``: an initial population (P, n_var) instead of pymoo's uniform one."""
     from pymoo.algorithms.moo.nsga2 import NSGA2
 
-    return NSGA2(pop_size=int(pop), eliminate_duplicates=True)
+    if sampling is None:
+        return NSGA2(pop_size=int(pop), eliminate_duplicates=True)
+    return NSGA2(pop_size=int(pop), sampling=np.asarray(sampling, float), eliminate_duplicates=True)
 
 
 # Checkpoint file: a header checked before anything is unpickled (unpickling runs code, so a
@@ -323,11 +326,13 @@ def load_checkpoint(path: Path, meta: dict):
 
 def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None = None,
         on_generation: Callable[[int, int], None] | None = None,
-        stop_after: int | None = None) -> RunResult:
+        stop_after: int | None = None, sampling=None) -> RunResult:
     """NSGA-II on ``problem``; checkpoints every ``rs.checkpoint_every`` generations.
 
     With an existing checkpoint of the same problem and settings the run resumes from it.
     ``stop_after`` stops after that many generations of this call (to test resuming).
+    ``sampling``: the initial population (P, n_var), when the problem has a better start than
+    uniform sampling of its box.
     """
     meta = {"problem": type(problem).__name__, "gait": problem.gait, "n_var": problem.n_var,
             "n_obj": problem.n_obj,
@@ -341,7 +346,7 @@ def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None
         algorithm.problem = problem  # re-attach the evaluator (never pickled)
         resumed = algorithm.n_gen - 1 if algorithm.n_gen else 0
     else:
-        algorithm = _algorithm(rs.pop)
+        algorithm = _algorithm(rs.pop, sampling)
         algorithm.setup(problem, termination=("n_gen", int(rs.gens)), seed=int(rs.seed),
                         verbose=False)
     done_here = 0

@@ -2,7 +2,9 @@
 
 ``<gait>.json`` (format "cpgbiped.optimize/1", written by :func:`cpg.search.optimize_primary`):
 ``chosen`` {weights, errors_deg, robustness}, ``pareto`` (list of the same), ``paper``,
-``settings``, ``i_app`` and ``phi``. ``secondary.json`` (format "cpgbiped.secondary/1").
+``settings``, ``i_app`` and ``phi``; ``<gait>_physics.json`` (the same format, ``"kind":
+"physics"``, written by :func:`envs.physics_optimize.optimize_physics`) also gives each point
+its own ``i_app`` and ``phi`` and its ``objectives``. ``secondary.json`` (format "cpgbiped.secondary/1").
 Readers of results (validate --weights, check-pareto, the demo, the dm_control "free" task)
 import this module only, so they start without loading pymoo.
 """
@@ -45,4 +47,19 @@ def load_result(path: str | Path) -> dict:
         raise InputError(f"{str(p)!r} lacks the network's i_app and phi") from None
     if not all(np.isfinite(cell)):
         raise InputError(f"{str(p)!r} holds an i_app or phi that is not finite")
+    # A physical search (``"kind": "physics"``) varies I_app and phi too: each point has its own.
+    for q in [data["chosen"]] + list(data["pareto"]):
+        for key in ("i_app", "phi"):
+            if key in q:
+                try:
+                    ok = np.isfinite(float(q[key]))
+                except (TypeError, ValueError):
+                    ok = False
+                if not ok:
+                    raise InputError(f"{str(p)!r} holds a point whose {key} is not finite")
     return data
+
+
+def point_cell(data: dict, point: dict) -> tuple[float, float]:
+    """(I_app, phi) of a point of a result: its own where it has them, else the file's."""
+    return (float(point.get("i_app", data["i_app"])), float(point.get("phi", data["phi"])))

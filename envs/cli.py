@@ -245,7 +245,58 @@ def _evaluator(a):
     return DaskEvaluator(None if a.dask == "local" else a.dask)
 
 
+def cmd_optimize_physics(a) -> int:
+    from cpg.optimize import RunSettings
+    from envs.physics_optimize import default_settings, optimize_physics
+    from envs.physics_search import check_gait
+    from envs.trials import DaskRunner, PoolRunner, SerialRunner
+
+    out_dir(a.out)
+    gait = check_gait(a.gait)
+    if a.robustness_objective or a.lock_time_objective or a.bounds != [-1.0, 1.0]:
+        raise _input_error("--robustness-objective, --lock-time-objective and --bounds belong "
+                           "to the phase search; --physics has its own objectives and box")
+    pop = 32 if a.pop is None else a.pop
+    gens = 20 if a.gens is None else a.gens
+    rs = RunSettings(pop, gens, a.seed, a.checkpoint_every)
+    settings = default_settings(gait, a.froude, a.seconds, a.trials)
+    args = (settings.seconds, settings.settle_s)
+    if a.dask is not None:
+        runner = DaskRunner(*args, address=None if a.dask == "local" else a.dask)
+    elif a.workers == 1:
+        runner = SerialRunner(*args)
+    else:
+        runner = PoolRunner(*args, workers=a.workers)
+    bar, cb = _progress(f"NSGA-II in physics, {gait}", rs.gens, not a.quiet)
+    try:
+        r = optimize_physics(gait, rs, a.out, settings, runner, cb)
+    finally:
+        bar.close()
+        runner.close()
+    c, p, f = r["chosen"], r["paper"], r["front"]
+    line = lambda name, q: (  # noqa: E731
+        f"  {name:7s} w = ({', '.join(f'{w:+.3f}' for w in q['weights'])}), I_app {q['i_app']:.3f}, "
+        f"phi {q['phi']:.3f}: Fr {q['metrics']['froude']:.4f}, cost {q['objectives']['cost']:.3f}, "
+        f"failed {q['objectives']['failed_fraction']:.2f}, {q['metrics']['physical_gait']}"
+        f"{', fell' if q['metrics']['fell'] else ''}")
+    print(f"{gait} in physics (Froude target {settings.froude:g}): {f['n_points']} Pareto points, "
+          f"Froude {f['froude_range'][0]:.4f}-{f['froude_range'][1]:.4f}, cost "
+          f"{f['cost_range'][0]:.3f}-{f['cost_range'][1]:.3f}")
+    print(line("chosen", c))
+    print(line("paper", p))
+    print(f"results in {a.out}/: {gait}_physics.json, {gait}_physics_population.csv, "
+          f"{gait}_physics_pareto.csv, {gait}_physics_pareto.png")
+    return 0
+
+
 def cmd_optimize(a) -> int:
+    if a.physics:
+        return cmd_optimize_physics(a)
+    a.pop = 40 if a.pop is None else a.pop
+    a.gens = 25 if a.gens is None else a.gens
+    for opt in ("froude", "seconds", "trials", "workers"):
+        if getattr(a, opt) is not None:
+            raise _input_error(f"--{opt} belongs to optimize --physics")
     from cpg.evaluate import SimSettings
     from cpg.optimize import RunSettings, check_bounds, primary_names
     from cpg.outdir import ResultDir
@@ -620,11 +671,40 @@ def build_parser() -> argparse.ArgumentParser:
         same way), DIR/<gait>_population.csv, DIR/<gait>_pareto.csv and a PNG of the front;
         with --gait all also DIR/comparison.md. A checkpoint is written every N generations;
         running the same command again after an interrupt resumes from it.
-        Defaults (pop 40, 25 generations) reach errors below 1 degree for all four gaits.""")
-    sp.add_argument("--gait", default="all", help="walk, run, jump, hop or all (default all)")
-    sp.add_argument("--pop", type=count_arg(4), default=40, help="population size (default 40)")
-    sp.add_argument("--gens", type=count_arg(1), default=25, help="generations (default 25)")
+        Defaults (pop 40, 25 generations) reach errors below 1 degree for all four gaits.
+
+        With --physics the search is physical: variables (w_a, w_b, w_c, I_app, phi) in a box
+        around Table 2 (weights [-1, 1], I_app [0.18, 0.35], phi [0.12, 0.5]); each point
+        drives the biped through the one controller (20 s after 2 s of settling) and meets
+        --trials perturbations drawn from the seed (random initial CPG state, friction x0.7-1.3,
+        a 2-6 N s push). Objectives: |Fr - Fr*|, cost of transport (walk, run) or work per
+        stride / (m g L) (jump, hop), fraction of perturbation trials failed; constraint: the
+        unperturbed rollout is the gait, without a fall. The first generation holds the
+        paper's row. Rollouts run in one process per core (--workers), or on Dask (--dask);
+        the same seed gives the same result either way. Writes DIR/<gait>_physics.json (read
+        by check-pareto), DIR/<gait>_physics_population.csv, DIR/<gait>_physics_pareto.csv and
+        DIR/<gait>_physics_pareto.png.""")
+    sp.add_argument("--gait", default="all", help="walk, run, jump, hop or all (default all; "
+                    "--physics takes one gait)")
+    sp.add_argument("--pop", type=count_arg(4), default=None,
+                    help="population size (default 40; 32 with --physics)")
+    sp.add_argument("--gens", type=count_arg(1), default=None,
+                    help="generations (default 25; 20 with --physics)")
     sp.add_argument("--seed", type=seed_arg, default=0, help="random seed (default 0)")
+    sp.add_argument("--physics", action="store_true",
+                    help="score (w_a, w_b, w_c, I_app, phi) by rollouts of the biped: objectives "
+                         "|Fr - Fr*|, cost of transport (work per stride for jump and hop), "
+                         "fraction of perturbation trials failed; constraint: the gait, no fall")
+    sp.add_argument("--froude", type=finite_arg, default=None, metavar="FR",
+                    help="--physics: target Froude number (default walk 0.25, run 0.5, jump and "
+                         "hop 0.02)")
+    sp.add_argument("--seconds", type=seconds_arg, default=None,
+                    help="--physics: measured seconds per rollout, after 2 s of settling "
+                         "(default 20)")
+    sp.add_argument("--trials", type=count_arg(0), default=None, metavar="N",
+                    help="--physics: perturbation trials per point (default 4)")
+    sp.add_argument("--workers", type=count_arg(1), default=None,
+                    help="--physics: rollout processes (default: one per core)")
     sp.add_argument("--bounds", type=float, nargs=2, default=[-1.0, 1.0], metavar=("LO", "HI"),
                     help="search box for every weight (default -1 1)")
     sp.add_argument("--checkpoint-every", type=count_arg(1), default=5, metavar="N",

@@ -11,7 +11,7 @@ from pathlib import Path
 from cpg.errors import InputError
 from cpg.io import to_json, write_json, write_text
 from cpg.outdir import ResultDir
-from cpg.results import load_result
+from cpg.results import load_result, point_cell
 
 
 def _one(args):
@@ -68,44 +68,53 @@ def check_pareto(result: str, out: str, first: int | None = None, seconds: float
         raise InputError(f"{result!r} holds no Pareto points to check")
     gait = data["gait"]
     with ResultDir(out) as rd:
-        jobs = [(gait, k, p["weights"], data["i_app"], data["phi"], seconds,
+        jobs = [(gait, k, p["weights"], *point_cell(data, p), seconds,
                  str(rd.staging) if render else None) for k, p in enumerate(points)]
         results = {k: (summary, video, rec) for k, summary, video, rec in
                    _pool_map(_one, jobs, workers, progress, f"physics check {gait}")}
-        report = _write(rd, result, gait, points, seconds, results, rrd)
+        report = _write(rd, result, data, gait, points, seconds, results, rrd)
         rd.commit()
     return report
 
 
-def _write(rd, result, gait, points, seconds, results, rrd) -> dict:
+def _write(rd, result, data, gait, points, seconds, results, rrd) -> dict:
     """Write the table, CSV and JSON into the staging folder; the report."""
     rows = []
     for k, p in enumerate(points):
         s, video, _ = results[k]
-        rows.append({"point": k, "weights": p["weights"], "errors_deg": p["errors_deg"],
+        i_app, phi = point_cell(data, p)
+        rows.append({"point": k, "weights": p["weights"], "i_app": i_app, "phi": phi,
+                     "errors_deg": p.get("errors_deg"), "objectives": p.get("objectives"),
                      **{key: s[key] for key in ("fell", "duty_factor", "lr_phase_lag",
                                                 "double_support", "flight", "stride_period_s",
                                                 "distance_m", "speed_mps", "physical_gait",
                                                 "cpg_gait", "passed")},
                      "video": video})
     md = [f"## Pareto points of {os.path.basename(result)} ({gait}) in physics, {seconds:g} s", "",
-          "| # | w_a, w_b, w_c | phase errors (deg) | fell | duty L/R | lag | flight | dist m "
-          "| physical | cpg | verdict |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+          "| # | w_a, w_b, w_c | I_app, phi | objectives | fell | duty L/R | lag | flight "
+          "| dist m | physical | cpg | verdict |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         d = r["duty_factor"]
+        obj = (r["objectives"] or {}) if r["errors_deg"] is None else {
+            "phase errors (deg)": ", ".join(f"{e:.3f}" for e in r["errors_deg"])}
         md.append(f"| {r['point']} | {', '.join(f'{w:.3f}' for w in r['weights'])} | "
-                  f"{', '.join(f'{e:.3f}' for e in r['errors_deg'])} | {'yes' if r['fell'] else 'no'} "
+                  f"{r['i_app']:.3f}, {r['phi']:.3f} | "
+                  f"{'; '.join(f'{n} {v:.3g}' if isinstance(v, float) else f'{n} {v}' for n, v in obj.items())} | "
+                  f"{'yes' if r['fell'] else 'no'} "
                   f"| {d['left']:.2f}/{d['right']:.2f} | {r['lr_phase_lag']:.2f} | {r['flight']:.2f} "
                   f"| {r['distance_m']:.2f} | {r['physical_gait']} | {r['cpg_gait']} | "
                   f"{'PASS' if r['passed'] else 'fail'} |")
     markdown = "\n".join(md) + "\n"
     buf = _io.StringIO()
     w = csv.writer(buf)
-    w.writerow(["point", "w_a", "w_b", "w_c", "z_RF", "z_LE", "z_RE", "fell", "duty_left",
+    w.writerow(["point", "w_a", "w_b", "w_c", "i_app", "phi", "z_RF", "z_LE", "z_RE", "fell",
+                "duty_left",
                 "duty_right", "lr_phase_lag", "double_support", "flight", "stride_period_s",
                 "distance_m", "speed_mps", "physical_gait", "cpg_gait", "passed"])
     for r in rows:
-        w.writerow([r["point"], *r["weights"], *r["errors_deg"], r["fell"], r["duty_factor"]["left"],
+        w.writerow([r["point"], *r["weights"], r["i_app"], r["phi"],
+                    *(r["errors_deg"] or ["", "", ""]), r["fell"], r["duty_factor"]["left"],
                     r["duty_factor"]["right"], r["lr_phase_lag"], r["double_support"], r["flight"],
                     r["stride_period_s"], r["distance_m"], r["speed_mps"], r["physical_gait"],
                     r["cpg_gait"], r["passed"]])

@@ -80,14 +80,16 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
             friction_scale: float = 1.0, push: tuple[float, float] | None = None,
             stop_on_fall: bool = True, ankle_drive: bool = True,
             to: Network | None = None, change: Schedule | None = None,
-            xml_path: str | Path = BIPED_SCENE) -> Recording:
+            xml_path: str | Path = BIPED_SCENE, poses: bool = True) -> Recording:
     """Run the CPG-driven biped for ``seconds`` of simulated time.
 
     Every tick records the joint positions and every body's world pose (forward kinematics of
     those positions). stop_on_fall=False keeps going after a fall (videos show it).
     push: (time s, impulse N s) horizontal impulse on the torso. ankle_drive=False removes the
     CPG's ankle drive (the reflexes stay). to, change: the network's parameters move towards
-    ``to``'s along ``change`` (knot times in seconds).
+    ``to``'s along ``change`` (knot times in seconds). poses=False skips the joint positions
+    and body poses (``qpos``, ``body_pose`` stay empty): searches that only need the metrics
+    save the forward kinematics of every tick.
     """
     seconds = check_seconds(seconds)
     push = check_push(push, seconds)
@@ -102,8 +104,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     dt = m.opt.timestep
     n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))
     rec = np.zeros((n_ticks, kernel.R_SIZE))
-    qpos_rec = np.zeros((n_ticks, m.nq))
-    pose_rec = np.zeros((n_ticks, m.nbody, 7))
+    qpos_rec = np.zeros((n_ticks if poses else 0, m.nq))
+    pose_rec = np.zeros((n_ticks if poses else 0, m.nbody, 7))
     # Poses from forward kinematics of the recorded qpos (after mj_step, MjData's own xpos is
     # that of the state before the last integration), on a second MjData the controller never
     # reads.
@@ -129,9 +131,10 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
             if status == 2 or bad_qacc.number:
                 unstable = f"physics became unstable at t={d.time:.3f} s"
                 break
-            qk[:] = qpos
-            mujoco.mj_kinematics(m, dk)
-            kernel.record_pose(k, qpos, xk, qk_rot, qpos_rec, pose_rec)
+            if poses:
+                qk[:] = qpos
+                mujoco.mj_kinematics(m, dk)
+                kernel.record_pose(k, qpos, xk, qk_rot, qpos_rec, pose_rec)
             n = k + 1
             if status == 1 and fell is None:
                 fell = float(d.time)
