@@ -294,3 +294,19 @@ def record_pose(k, qpos, xpos, xquat, qpos_rec, pose_rec):
             pose_rec[k, b, c] = xpos[b, c]
         for c in range(4):
             pose_rec[k, b, 3 + c] = xquat[b, c]
+
+
+@njit(cache=True)
+def tick(k, t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix,
+         v, a, rec, fall_height, fall_pitch):
+    """One control tick of a rollout in one call: record row k - 1 (the state the last physics
+    steps reached, under the controls still in ``ctrl``), then write the controls for time t_s
+    into ``ctrl``. Returns the status of row k - 1 (:func:`record`; 0 when k = 0)."""
+    status = 0
+    if k > 0:
+        status = record(k - 1, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, S, rec,
+                        fall_height, fall_pitch)
+        if status == 2:
+            return status
+    control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, ctrl, v, a)
+    return status

@@ -118,31 +118,75 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     ix, v, a, S = ctrl.ix, ctrl.last_v, ctrl.last_a, ctrl.S
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
     push_tick = None if push is None else int(round(push[0] / (dt * CONTROL_EVERY)))
+    sv, sa, sdt, P, qvel = ctrl.sched.v, ctrl.sched.a, ctrl.sched.dt_s, ctrl.P, d.qvel
+    if not poses:  # the whole loop compiled (envs.step_loop): the same rows, bit for bit
+        n, fell, unstable = _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec,
+                                           stop_on_fall)
+        return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path)
     try:
-        for k in range(n_ticks):
-            ctrl_in[:] = ctrl(d.time)
+        # Tick k records row k - 1 (the state after the last steps) and sets the controls of
+        # tick k, in one compiled call (kernel.tick); the loop runs one extra tick for the
+        # last row.
+        for k in range(n_ticks + 1):
+            status = kernel.tick(k, d.time, sv, sa, sdt, P, S, qpos, qvel, sens, xpos, act,
+                                 ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
+            if k > 0:
+                if status == 2 or bad_qacc.number:
+                    unstable = f"physics became unstable at t={d.time:.3f} s"
+                    break
+                if poses:
+                    qk[:] = qpos
+                    mujoco.mj_kinematics(m, dk)
+                    kernel.record_pose(k - 1, qpos, xk, qk_rot, qpos_rec, pose_rec)
+                n = k
+                if status == 1 and fell is None:
+                    fell = float(d.time)
+                    if stop_on_fall:
+                        break
+            if k == n_ticks:
+                break
             if k == push_tick:  # impulse = force x duration
                 d.xfrc_applied[torso_id, 0] = push[1] / (dt * CONTROL_EVERY)
             mujoco.mj_step(m, d, nstep=CONTROL_EVERY)
             if k == push_tick:
                 d.xfrc_applied[torso_id, 0] = 0.0
-            status = kernel.record(k, d.time, qpos, sens, xpos, act, ctrl_in, afrc, avel, ix, v,
-                                   a, S, rec, FALL_HEIGHT, FALL_PITCH)
-            if status == 2 or bad_qacc.number:
-                unstable = f"physics became unstable at t={d.time:.3f} s"
-                break
-            if poses:
-                qk[:] = qpos
-                mujoco.mj_kinematics(m, dk)
-                kernel.record_pose(k, qpos, xk, qk_rot, qpos_rec, pose_rec)
-            n = k + 1
-            if status == 1 and fell is None:
-                fell = float(d.time)
-                if stop_on_fall:
-                    break
     except mujoco.FatalError as e:
         raise InputError(f"physics became unstable: {e}") from None
     return _recording(rec[:n], dt, fell, unstable, qpos_rec[:n], pose_rec[:n], xml_path)
+
+
+COMPILED_CHUNK = 250  # ticks (1 s) between two looks at MuJoCo's warnings
+
+
+def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_fall):
+    """The tick loop of :func:`rollout` in compiled chunks; (rows, fell_at, unstable)."""
+    from .step_loop import run_ticks
+
+    dt = m.opt.timestep
+    bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
+    force = 0.0 if push is None else push[1] / (dt * CONTROL_EVERY)
+    args = (d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl, d.actuator_force,
+            d.actuator_velocity, ctrl.ix, ctrl.last_v, ctrl.last_a, rec, FALL_HEIGHT,
+            FALL_PITCH, -1 if push_tick is None else push_tick, force, d.xfrc_applied, torso_id)
+    k, n, fell = 0, 0, None
+    sched = ctrl.sched
+    while k <= n_ticks:
+        k_end = min(k + COMPILED_CHUNK, n_ticks + 1)
+        k_next, status = run_ticks(m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY,
+                                   d.time, dt, sched.v, sched.a, sched.dt_s, ctrl.P, ctrl.S,
+                                   *args)
+        if bad_qacc.number:  # somewhere in this chunk: keep the rows recorded before it
+            return max(k - 1, 0), fell, f"physics became unstable at t={d.time:.3f} s"
+        if status == 2:  # row k_next - 2 is not finite
+            return k_next - 2, fell, f"physics became unstable at t={d.time:.3f} s"
+        n = k_next - 1
+        if status == 1:
+            if fell is None:
+                fell = float(rec[n - 1, kernel.R_T])
+            if stop_on_fall:
+                return n, fell, None
+        k = k_next
+    return n, fell, None
 
 
 def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path) -> Recording:

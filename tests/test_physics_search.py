@@ -193,3 +193,24 @@ def test_bad_input_one_line_no_files(tmp_path, args, message):
     lines = p.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("cpgbiped: error:") and message in lines[0]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("gait, kw", [("walk", {"push": (3.0, 5.0)}),
+                                      ("hop", {"push": (3.0, -100.0)}),
+                                      ("run", {"push": (3.0, -100.0), "stop_on_fall": False}),
+                                      ("jump", {"friction_scale": 0.7})])
+def test_compiled_loop_gives_the_python_loops_rows(gait, kw):
+    """rollout(poses=False) runs the tick loop compiled (envs.step_loop); every recorded row,
+    the fall time and the length must be those of the Python loop, bit for bit."""
+    from cpg.network import build
+    from envs.rollout import rollout
+
+    a = rollout(build("ml", gait), 6.0, **kw)
+    b = rollout(build("ml", gait), 6.0, poses=False, **kw)
+    assert a.fell_at == b.fell_at and a.unstable == b.unstable and len(a.t) == len(b.t)
+    for f in ("t", "contact", "force", "cpg_v", "activation", "joints", "com_x", "com_z",
+              "modes", "ctrl", "power"):
+        assert np.array_equal(getattr(a, f), getattr(b, f)), f
+    assert b.qpos.shape[0] == 0 and b.body_pose.shape[0] == 0
+    if kw.get("push", (0, 0))[1] == -100.0:
+        assert a.fell_at is not None  # the shove is a real fall, so the fall path is covered
