@@ -343,6 +343,8 @@ def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None
     resumed = None
     if ckpt is not None and ckpt.exists():
         algorithm = load_checkpoint(ckpt, meta)
+        if hasattr(problem, "restore"):  # state the problem keeps across generations
+            problem.restore(algorithm.problem)
         algorithm.problem = problem  # re-attach the evaluator (never pickled)
         resumed = algorithm.n_gen - 1 if algorithm.n_gen else 0
     else:

@@ -400,12 +400,13 @@ def _network(a):
         return net, f"{kind} {preset}" + (f", seed {a.seed}" if a.seed is not None else "")
     if kind != "ml":
         raise _input_error("--weights holds Morris-Lecar weights: use it with --network ml")
-    from cpg.results import load_result
+    from cpg.results import load_result, point_cell
 
     data = load_result(a.weights)
     preset = a.preset or data["gait"]
-    net = build("ml", preset, weights=data["chosen"]["weights"], i_app=data["i_app"],
-                phi=data["phi"], seed=a.seed)
+    i_app, phi = point_cell(data, data["chosen"])
+    net = build("ml", preset, weights=data["chosen"]["weights"], i_app=i_app, phi=phi,
+                seed=a.seed)
     return net, f"ml {preset} with the weights of {a.weights}"
 
 

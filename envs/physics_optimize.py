@@ -9,7 +9,8 @@ Files in the output folder (all replaced at once when the run succeeds):
 - ``<gait>_physics_population.csv`` and ``<gait>_physics_pareto.csv``;
 - ``<gait>_physics_pareto.png``: the three 2-D projections of the objectives.
 
-The chosen point is the most robust feasible Pareto point (fewest failed perturbation trials),
+The Pareto set is taken over every point evaluated during the search (the final population
+alone crowds into one region). The chosen point is the most robust feasible Pareto point (fewest failed perturbation trials),
 then the one closest to the Froude target, then the cheapest. A checkpoint beside the folder
 lets an interrupted run resume (the same command again); a run that ends removes it.
 """
@@ -109,10 +110,10 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
     problem = PhysicsGaitProblem(gait, settings, rs.seed, runner)
     res = run(problem, rs, checkpoint=ckpt, on_generation=progress, stop_after=stop_after,
               sampling=initial_population(gait, rs.pop, rs.seed))
-    feasible = res.pareto_F is not None and len(res.pareto_X) and (res.G[:, 0] <= 0).any()
-    # The Pareto set and the paper's row, rolled out again for their metrics (every rollout is
-    # deterministic: the objectives come out as the search saw them).
-    X_opt = np.atleast_2d(res.pareto_X) if feasible else np.zeros((0, 5))
+    # The Pareto set over every point the search evaluated, and the paper's row, rolled out
+    # again for their metrics (every rollout is deterministic: the objectives come out as the
+    # search saw them).
+    X_opt, _ = problem.pareto_set()
     X_all = np.vstack([X_opt, paper_point(gait)[None], res.X])
     F_all, G_all, trials = problem.evaluate_points(X_all)
     n = len(X_opt)
@@ -124,7 +125,7 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
                          f"another gait): raise --pop or --gens, or widen the search")
     k = choose(points)
     front = {
-        "n_points": n,
+        "n_points": n, "n_evaluated": int(len(problem.archive_X)),
         "froude_spread": spread(p["metrics"]["froude"] for p in points),
         "cost_spread": spread(p["objectives"]["cost"] for p in points),
         "froude_range": [min(p["metrics"]["froude"] for p in points),

@@ -153,6 +153,13 @@ class PhysicsGaitProblem(Problem):
         self.conditions = perturbations(gait, settings, seed)
         self.runner = runner
         self.last: list[list[TrialResult]] | None = None
+        # Every point evaluated during the search (kept in checkpoints): the Pareto set is
+        # taken over all of them, not only over the final population, which NSGA-II crowds
+        # into one region once the perturbation objective's steps (multiples of 1/n_trials)
+        # dominate.
+        self.archive_X = np.zeros((0, 5))
+        self.archive_F = np.zeros((0, 3))
+        self.archive_G = np.zeros(0)
         lo = [WEIGHT_BOUNDS[0]] * 3 + [I_APP_BOUNDS[0], PHI_BOUNDS[0]]
         hi = [WEIGHT_BOUNDS[1]] * 3 + [I_APP_BOUNDS[1], PHI_BOUNDS[1]]
         super().__init__(n_var=5, n_obj=3, n_ieq_constr=1, xl=np.array(lo), xu=np.array(hi))
@@ -173,8 +180,30 @@ class PhysicsGaitProblem(Problem):
 
     def _evaluate(self, X, out, *args, **kwargs):
         F, G_, self.last = self.evaluate_points(X)
+        self.archive_X = np.vstack([self.archive_X, np.atleast_2d(X)])
+        self.archive_F = np.vstack([self.archive_F, F])
+        self.archive_G = np.concatenate([self.archive_G, G_])
         out["F"] = F
         out["G"] = G_[:, None]
+
+    def restore(self, saved: "PhysicsGaitProblem") -> None:
+        """Take over the archive of the problem a checkpoint saved (resuming a run)."""
+        self.archive_X, self.archive_F, self.archive_G = (saved.archive_X, saved.archive_F,
+                                                          saved.archive_G)
+
+    def pareto_set(self) -> tuple[np.ndarray, np.ndarray]:
+        """(X, F) of the feasible points of the archive that no other feasible point dominates
+        (duplicates removed), ordered by the first objective."""
+        from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+        ok = self.archive_G <= 0
+        if not ok.any():
+            return np.zeros((0, 5)), np.zeros((0, 3))
+        X, idx = np.unique(self.archive_X[ok], axis=0, return_index=True)
+        F = self.archive_F[ok][idx]
+        front = NonDominatedSorting().do(F, only_non_dominated_front=True)
+        order = front[np.lexsort(F[front].T[::-1])]
+        return X[order], F[order]
 
     def __getstate__(self):  # checkpoints never hold worker processes or a cluster
         state = self.__dict__.copy()

@@ -214,3 +214,19 @@ def test_compiled_loop_gives_the_python_loops_rows(gait, kw):
     assert b.qpos.shape[0] == 0 and b.body_pose.shape[0] == 0
     if kw.get("push", (0, 0))[1] == -100.0:
         assert a.fell_at is not None  # the shove is a real fall, so the fall path is covered
+
+
+def test_pareto_set_is_the_feasible_non_dominated_archive():
+    p = PhysicsGaitProblem("walk", SMALL, 0)
+    p.archive_X = np.arange(6 * 5, dtype=float).reshape(6, 5)
+    p.archive_F = np.array([[1.0, 1.0, 0.0],   # on the front
+                            [2.0, 0.5, 0.0],   # on the front
+                            [2.0, 2.0, 0.0],   # dominated by the first
+                            [0.1, 0.1, 0.0],   # dominates all, but infeasible
+                            [0.5, 3.0, 0.25],  # on the front (best first objective)
+                            [1.0, 1.0, 0.0]])  # a copy of the first's objectives, other X
+    p.archive_G = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+    X, F = p.pareto_set()
+    assert {tuple(f) for f in F} == {(1.0, 1.0, 0.0), (2.0, 0.5, 0.0), (0.5, 3.0, 0.25)}
+    assert not any(np.array_equal(x, p.archive_X[3]) for x in X)  # the infeasible point
+    assert np.all(np.diff(F[:, 0]) >= 0)
