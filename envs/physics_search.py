@@ -7,7 +7,9 @@ presets' weights the network oscillates at every corner of the box, at periods o
 model units (0.35-1.1 s at 19.5 units/s).
 
 Objectives, all minimised (:data:`OBJECTIVES`):
-- ``froude_error``: |Fr - Fr*|, Fr = v^2 / (g L) of the unperturbed rollout and Fr* the target
+- ``froude_error``: |sign(v) Fr - Fr*|, Fr = v^2 / (g L) of the unperturbed rollout (signed
+  by the direction of travel: drifting backwards counts against a forward target) and Fr* the
+  target
   (``--froude``; defaults in :data:`FROUDE_TARGET`). The window is 20 s by default: the
   paper's walk needs more than 10 s to reach its speed (measured: named "none" over 5 and 10 s
   windows, walk over 20 s);
@@ -137,7 +139,9 @@ def score(gait: str, settings: PhysicsSettings, results: list[TrialResult]
     """(objectives (3,), constraint) of one individual from its trials' results (the
     unperturbed first)."""
     base, pert = results[0], results[1:]
-    fr = base.froude if np.isfinite(base.froude) else 0.0
+    # Signed: a gait that drifts backwards is farther from a forward target, not as close as
+    # the same speed forwards (the first jump runs rewarded a backward drift).
+    fr = base.froude * np.sign(base.speed_mps) if np.isfinite(base.froude) else 0.0
     failed = float(np.mean([trial_failed(gait, r) for r in pert])) if pert else 0.0
     F = np.array([abs(fr - settings.froude), cost_of(gait, base), failed])
     return F, violation(gait, base, settings.settle_s + settings.seconds)

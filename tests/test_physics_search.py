@@ -25,9 +25,9 @@ SMALL = PhysicsSettings(froude=0.5, seconds=4.0, n_trials=1)
 RS = RunSettings(pop=4, gens=3, seed=7, checkpoint_every=1)
 
 
-def result(fell=False, gait="walk", froude=0.1, cot=1.0, work=20.0, survived=12.0):
-    nan = math.nan
-    return TrialResult(fell, survived, gait, froude, nan, cot, work, 0.6, 0.0, 1.0, 0.0)
+def result(fell=False, gait="walk", froude=0.1, cot=1.0, work=20.0, survived=12.0, v=None):
+    v = math.sqrt(froude * G * body_constants()[0]) if v is None else v
+    return TrialResult(fell, survived, gait, froude, v, cot, work, 0.6, 0.0, 1.0, 0.0)
 
 
 def test_score_objectives_and_graded_constraint():
@@ -42,6 +42,9 @@ def test_score_objectives_and_graded_constraint():
     leg, mass = body_constants()[:2]
     F, _ = score("hop", s, [result(gait="hop", work=30.0)])
     assert F[1] == pytest.approx(30.0 / (mass * G * leg))
+    # Backwards at the same speed is farther from a forward target.
+    F, _ = score("jump", s, [result(gait="jump", froude=0.1, v=-1.0)])
+    assert F[0] == pytest.approx(0.35)
     # A walk in place has no cost of transport: the in-place penalty, not NaN.
     F, _ = score("walk", s, [result(cot=math.nan)])
     assert np.isfinite(F).all() and F[1] >= 10.0
@@ -115,8 +118,9 @@ def test_small_run_result_is_read_by_check_pareto(tmp_path):
     assert all(p["feasible"] for p in data["pareto"])
     # Objectives recomputed from each point's own metrics.
     for p in data["pareto"]:
-        assert p["objectives"]["froude_error"] == pytest.approx(
-            abs(p["metrics"]["froude"] - SMALL.froude), abs=1e-6)
+        signed = p["metrics"]["froude"] * np.sign(p["metrics"]["speed_mps"])
+        assert p["objectives"]["froude_error"] == pytest.approx(abs(signed - SMALL.froude),
+                                                                abs=1e-6)
         assert p["objectives"]["cost"] == pytest.approx(p["metrics"]["cost_of_transport"],
                                                         abs=1e-6)
     for f in ("run_physics_population.csv", "run_physics_pareto.csv", "run_physics_pareto.png"):
