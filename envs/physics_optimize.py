@@ -42,8 +42,9 @@ def checkpoint_name(gait: str) -> str:
 
 def _point(x, f, g, results) -> dict:
     base = results[0].as_dict()
-    return {"weights": [round(float(v), 6) for v in x[:3]], "i_app": round(float(x[3]), 6),
-            "phi": round(float(x[4]), 6),
+    # Full precision: the body is chaotic enough that weights rounded to 1e-6 walk differently
+    # (measured: a chosen run that did not fall in the search fell at 11.7 s once rounded).
+    return {"weights": [float(v) for v in x[:3]], "i_app": float(x[3]), "phi": float(x[4]),
             "objectives": {n: round(float(v), 6) for n, v in zip(OBJECTIVES, f)},
             "constraint": round(float(g), 6), "feasible": bool(g <= 0),
             "metrics": {k: base[k] for k in METRICS},
@@ -121,8 +122,8 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
     paper = _point(X_all[n], F_all[n], G_all[n], trials[n])
     pop = slice(n + 1, None)
     if not points:
-        raise InputError(f"no feasible point for {gait} (every final member falls or walks "
-                         f"another gait): raise --pop or --gens, or widen the search")
+        raise InputError(f"no feasible point for {gait}: all {len(problem.archive_X)} points "
+                         f"evaluated fall or make another gait; raise --pop or --gens")
     k = choose(points)
     front = {
         "n_points": n, "n_evaluated": int(len(problem.archive_X)),
