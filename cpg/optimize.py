@@ -182,27 +182,31 @@ def _evaluate_chunk(args):
     return evaluate(gait, i_app, phi, W, y0, settings, **kw)
 
 
+def connect_dask(address: str | None, n_workers: int = 2):
+    """(Client, LocalCluster or None): a LocalCluster of ``n_workers`` single-thread processes
+    when ``address`` is None, else the scheduler at ``tcp://host:port``; clear errors."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover - pinned dependency
+        raise InputError("dask.distributed is not installed") from None
+    if address is not None and not str(address).startswith("tcp://"):
+        raise InputError(f"Dask scheduler address must look like tcp://host:port, got {address!r}")
+    try:
+        if address is None:
+            cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            return Client(cluster), cluster
+        return Client(address, timeout="10s"), None
+    except OSError as e:
+        raise InputError(f"cannot reach the Dask scheduler {address!r}: {e}") from None
+
+
 class DaskEvaluator:
     """Evaluate population chunks on a Dask cluster (a LocalCluster when no address)."""
 
     def __init__(self, address: str | None = None, n_chunks: int | None = None,
                  n_workers: int = 2):
-        try:
-            from distributed import Client, LocalCluster
-        except ImportError:  # pragma: no cover - pinned dependency
-            raise InputError("dask.distributed is not installed") from None
-        if address is not None and not str(address).startswith("tcp://"):
-            raise InputError(f"Dask scheduler address must look like tcp://host:port, got {address!r}")
-        self.cluster = None
-        try:
-            if address is None:
-                self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1,
-                                            processes=True, dashboard_address=None)
-                self.client = Client(self.cluster)
-            else:
-                self.client = Client(address, timeout="10s")
-        except OSError as e:
-            raise InputError(f"cannot reach the Dask scheduler {address!r}: {e}") from None
+        self.client, self.cluster = connect_dask(address, n_workers)
         self.n_chunks = n_chunks or max(1, len(self.client.scheduler_info().get("workers", {})))
 
     def __call__(self, gait, i_app, phi, W, y0, settings, **kw) -> Evaluation:

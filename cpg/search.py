@@ -28,7 +28,7 @@ TIE_DEG = 0.01
 N_TIE_CANDIDATES = 8
 
 
-def _csv(path: Path, header: list[str], rows) -> None:
+def write_csv(path: Path, header: list[str], rows) -> None:
     buf = _io.StringIO()
     w = csv.writer(buf)
     w.writerow(header)
@@ -37,7 +37,10 @@ def _csv(path: Path, header: list[str], rows) -> None:
     write_text(path, buf.getvalue())
 
 
-def _plot_front(path: Path, F_pop: np.ndarray, F_opt: np.ndarray, title: str, names) -> None:
+def plot_front(path: Path, F_pop: np.ndarray, F_opt: np.ndarray, title: str, names,
+               symlog: bool = True) -> None:
+    """The three 2-D projections of a 3-objective front (grey: the final population; red: the
+    Pareto set); ``names`` label the axes; ``symlog`` for phase errors that span decades."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -47,10 +50,11 @@ def _plot_front(path: Path, F_pop: np.ndarray, F_opt: np.ndarray, title: str, na
     for ax, (a, b) in zip(axes, ((0, 1), (0, 2), (1, 2))):
         ax.scatter(F_pop[:, a], F_pop[:, b], s=10, c="0.7", label="final population")
         ax.scatter(F_opt[:, a], F_opt[:, b], s=18, c="tab:red", label="Pareto set")
-        ax.set_xscale("symlog", linthresh=1e-3)
-        ax.set_yscale("symlog", linthresh=1e-3)
-        ax.set_xlabel(f"{names[a]} (deg)")
-        ax.set_ylabel(f"{names[b]} (deg)")
+        if symlog:
+            ax.set_xscale("symlog", linthresh=1e-3)
+            ax.set_yscale("symlog", linthresh=1e-3)
+        ax.set_xlabel(names[a])
+        ax.set_ylabel(names[b])
     axes[0].legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
@@ -157,15 +161,15 @@ def _optimize_primary(rd: ResultDir, gait, rs, lo, hi, settings, evaluator, prog
     # The final population with the reason each member passed or failed.
     ev = evaluate(gait, problem.i_app, problem.phi, ml.weight_matrix(res.X), problem.y0, settings)
     head = ["w_a", "w_b", "w_c", "z_RF", "z_LE", "z_RE", "constraint", "status", "classified"]
-    _csv(rd.path(f"{gait}_population.csv"), head,
+    write_csv(rd.path(f"{gait}_population.csv"), head,
          [[*np.round(x, 6), *np.round(f, 6), round(float(g), 6), r, c]
           for x, f, g, r, c in zip(res.X, ev.F, ev.G, ev.reasons, ev.classified)])
-    _csv(rd.path(f"{gait}_pareto.csv"), ["w_a", "w_b", "w_c", *names, "robustness"],
+    write_csv(rd.path(f"{gait}_pareto.csv"), ["w_a", "w_b", "w_c", *names, "robustness"],
          [[*np.round(x, 6), *np.round(f, 6), "" if not np.isfinite(r) else r]
           for x, f, r in zip(ok, F_opt, rob)])
-    _plot_front(rd.path(f"{gait}_pareto.png"), res.F[:, :3], F_opt[:, :3],
-                f"{gait}: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed {rs.seed}",
-                ("z_RF", "z_LE", "z_RE"))
+    plot_front(rd.path(f"{gait}_pareto.png"), res.F[:, :3], F_opt[:, :3],
+               f"{gait}: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed {rs.seed}",
+               ("z_RF (deg)", "z_LE (deg)", "z_RE (deg)"))
     write_json(rd.path(f"{gait}.json"), result)
     return result
 

@@ -17,6 +17,7 @@ lets an interrupted run resume (the same command again); a run that ends removes
 from __future__ import annotations
 
 import time
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -26,11 +27,11 @@ from cpg.io import write_json
 from cpg.optimize import RunSettings, run
 from cpg.outdir import ResultDir
 from cpg.results import FORMAT
-from cpg.search import _csv
+from cpg.search import plot_front, write_csv
 
 from .physics_search import (FROUDE_TARGET, I_APP_BOUNDS, OBJECTIVES, PHI_BOUNDS, VARIABLES,
                              WEIGHT_BOUNDS, PhysicsGaitProblem, PhysicsSettings, check_gait,
-                             initial_population, paper_point, settings_dict)
+                             initial_population, paper_point, trial_failed)
 
 METRICS = ("froude", "speed_mps", "cost_of_transport", "work_per_stride_J", "duty", "flight",
            "stride_period_s", "apex_height_m", "physical_gait", "fell")
@@ -40,7 +41,7 @@ def checkpoint_name(gait: str) -> str:
     return f"{gait}_physics.checkpoint.pkl"
 
 
-def _point(x, f, g, results) -> dict:
+def _point(gait, x, f, g, results) -> dict:
     base = results[0].as_dict()
     # Full precision: the body is chaotic enough that weights rounded to 1e-6 walk differently
     # (measured: a chosen run that did not fall in the search fell at 11.7 s once rounded).
@@ -48,8 +49,7 @@ def _point(x, f, g, results) -> dict:
             "objectives": {n: round(float(v), 6) for n, v in zip(OBJECTIVES, f)},
             "constraint": round(float(g), 6), "feasible": bool(g <= 0),
             "metrics": {k: base[k] for k in METRICS},
-            "perturbation_failures": [bool(r.fell or r.physical_gait != results[0].physical_gait)
-                                      for r in results[1:]]}
+            "perturbation_failures": [trial_failed(gait, r) for r in results[1:]]}
 
 
 def choose(points: list[dict]) -> int:
@@ -64,28 +64,6 @@ def spread(values) -> float:
     """End-to-end relative spread of positive values: max / min - 1 (NaN for fewer than 2)."""
     v = np.asarray([x for x in values if x is not None and np.isfinite(x) and x > 0], float)
     return float(v.max() / v.min() - 1.0) if len(v) >= 2 else float("nan")
-
-
-def _plot(path: Path, F_pop, F_opt, title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from cpg.io import atomic_path
-
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
-    for ax, (a, b) in zip(axes, ((0, 1), (0, 2), (1, 2))):
-        ax.scatter(F_pop[:, a], F_pop[:, b], s=10, c="0.7", label="final population")
-        ax.scatter(F_opt[:, a], F_opt[:, b], s=18, c="tab:red", label="Pareto set")
-        ax.set_xlabel(OBJECTIVES[a])
-        ax.set_ylabel(OBJECTIVES[b])
-    axes[0].legend(fontsize=8)
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    with atomic_path(path, suffix=".png") as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
 
 
 def optimize_physics(gait: str, rs: RunSettings, out: str | Path, settings: PhysicsSettings,
@@ -118,8 +96,8 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
     X_all = np.vstack([X_opt, paper_point(gait)[None], res.X])
     F_all, G_all, trials = problem.evaluate_points(X_all)
     n = len(X_opt)
-    points = [_point(X_all[k], F_all[k], G_all[k], trials[k]) for k in range(n)]
-    paper = _point(X_all[n], F_all[n], G_all[n], trials[n])
+    points = [_point(gait, X_all[k], F_all[k], G_all[k], trials[k]) for k in range(n)]
+    paper = _point(gait, X_all[n], F_all[n], G_all[n], trials[n])
     pop = slice(n + 1, None)
     if not points:
         raise InputError(f"no feasible point for {gait}: all {len(problem.archive_X)} points "
@@ -141,7 +119,7 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
         "bounds": {"weights": list(WEIGHT_BOUNDS), "i_app": list(I_APP_BOUNDS),
                    "phi": list(PHI_BOUNDS)},
         "settings": {"pop": rs.pop, "gens": rs.gens, "seed": rs.seed,
-                     "physics": settings_dict(settings)},
+                     "physics": asdict(settings)},
         "froude_target": settings.froude,
         "perturbations": problem.conditions,
         "chosen": points[k], "pareto": points, "paper": paper, "front": front,
@@ -154,13 +132,13 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
         [*np.round(x, 6), *np.round(f, 6), round(float(g), 6),
          *[t[0].as_dict()[c] for c in head[len(VARIABLES) + len(OBJECTIVES) + 1:]]]
         for x, f, g, t in zip(X, F, G, T)]
-    _csv(rd.path(f"{gait}_physics_population.csv"), head,
+    write_csv(rd.path(f"{gait}_physics_population.csv"), head,
          rows(X_all[pop], F_all[pop], G_all[pop], trials[pop]))
-    _csv(rd.path(f"{gait}_physics_pareto.csv"), head,
+    write_csv(rd.path(f"{gait}_physics_pareto.csv"), head,
          rows(X_all[:n], F_all[:n], G_all[:n], trials[:n]))
-    _plot(rd.path(f"{gait}_physics_pareto.png"), F_all[pop], F_all[:n],
-          f"{gait} in physics: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed {rs.seed}, "
-          f"Fr* {settings.froude:g}")
+    plot_front(rd.path(f"{gait}_physics_pareto.png"), F_all[pop], F_all[:n],
+               f"{gait} in physics: NSGA-II pop {rs.pop}, {res.n_gen} generations, seed "
+               f"{rs.seed}, Fr* {settings.froude:g}", OBJECTIVES, symlog=False)
     write_json(rd.path(f"{gait}_physics.json"), result)
     return result
 

@@ -34,7 +34,7 @@ same in one process, in a pool of processes or on a Dask cluster.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 from pymoo.core.problem import Problem
@@ -236,6 +236,3 @@ def initial_population(gait: str, pop: int, seed: int) -> np.ndarray:
     far = lo + rng.random((int(pop) - 1 - n_near, 5)) * (hi - lo)
     return np.vstack([x0[None], near, far])
 
-
-def settings_dict(s: PhysicsSettings) -> dict:
-    return asdict(s)

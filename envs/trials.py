@@ -70,7 +70,7 @@ class TrialResult:
         return asdict(self)
 
 
-def _failed(total_s: float, why: str) -> TrialResult:
+def _failed(why: str) -> TrialResult:
     nan = float("nan")
     return TrialResult(True, 0.0, "none", nan, nan, nan, nan, nan, nan, nan, nan, why)
 
@@ -94,7 +94,7 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         rec = rollout(net, total, friction_scale=trial.friction_scale, push=trial.push,
                       stop_on_fall=stop_on_fall, poses=False)
     except InputError as e:  # a network that diverges cannot drive the body
-        return _failed(total, str(e))
+        return _failed(str(e))
     v = measure_recording(net, None, rec, settle_s)
     m, b = v.metrics, v.biomech
     fell = bool(m.fell) or rec.unstable is not None
@@ -103,8 +103,7 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         fell=fell, survived_s=survived if fell else total, physical_gait=m.physical_gait,
         froude=_num(b.froude), speed_mps=_num(m.speed_mps),
         cost_of_transport=_num(b.cost_of_transport), work_per_stride_J=_num(b.work_per_stride_J),
-        duty=float(np.nanmean([m.duty_factor["left"], m.duty_factor["right"]]))
-        if np.isfinite([m.duty_factor["left"], m.duty_factor["right"]]).any() else float("nan"),
+        duty=mean_finite([m.duty_factor["left"], m.duty_factor["right"]]),
         flight=_num(m.flight), stride_period_s=_num(m.stride_period_s),
         apex_height_m=_num(b.apex_height_m), error=rec.unstable)
 
@@ -185,23 +184,9 @@ class DaskRunner(SerialRunner):
     def __init__(self, seconds: float, settle_s: float = SETTLE_S, stop_on_fall: bool = True,
                  address: str | None = None, workers: int = 2):
         super().__init__(seconds, settle_s, stop_on_fall)
-        try:
-            from distributed import Client, LocalCluster
-        except ImportError:  # pragma: no cover - pinned dependency
-            raise InputError("dask.distributed is not installed") from None
-        if address is not None and not str(address).startswith("tcp://"):
-            raise InputError(f"Dask scheduler address must look like tcp://host:port, "
-                             f"got {address!r}")
-        self.cluster = None
-        try:
-            if address is None:
-                self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
-                                            processes=True, dashboard_address=None)
-                self.client = Client(self.cluster)
-            else:
-                self.client = Client(address, timeout="10s")
-        except OSError as e:
-            raise InputError(f"cannot reach the Dask scheduler {address!r}: {e}") from None
+        from cpg.optimize import connect_dask
+
+        self.client, self.cluster = connect_dask(address, workers)
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
 
     def __call__(self, trials: list[Trial]) -> list[TrialResult]:
