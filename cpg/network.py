@@ -45,9 +45,19 @@ from .integrate import DT_ML, Schedule, Trajectory, rk4, simulate_ml
 KINDS = ("ml", "hopf", "matsuoka")
 
 # Morris-Lecar model time units per second of physics: one number for every preset and weight
-# set (the paper's periods 13.1, 8.87, 12.0, 7.92 units give strides of about 1.0, 0.68, 0.92
-# and 0.61 s: the network's own periods set the cadences).
-ML_UNITS_PER_S = 19.5
+# set, chosen by dynamic similarity. Two bodies move alike when their stride periods scale with
+# sqrt(L / g) (L the leg length). Adults (leg about 0.90 m) stride about every 1.1 s walking at
+# their preferred speed and about every 0.7 s jogging (typical values); for this biped's leg (L = 0.862 m, the standing hip height of models/biped) that is
+# 1.1 sqrt(0.862 / 0.90) = 1.08 s and 0.69 s. The Table 2 walk's period, 13.113 units, lands on
+# 1.08 s at 12.2 units/s, and the run's, 8.868 units, on 0.69 s at 12.9; the walk, the gait
+# every network and weight set is first judged by, sets the unit: 12.3 units/s gives strides of
+# 1.066 s (walk), 0.721 s (run, 5% slower than the scaled human jog), 0.974 s (two-legged
+# jump) and 0.644 s (two-legged hop, 1.55 Hz). Alexander's relation
+# lambda / L = 2.3 Fr^0.3 with lambda = v T turns a stride period T into the Froude number of a
+# dynamically similar gait, Fr = (2.3 sqrt(L / g) / T)^5: 0.11 for the walk's 1.066 s (a
+# stroll) and 0.76 for the run's 0.721 s (a jog). The earlier 19.5 units/s gave the walk a
+# 0.67 s stride, which that relation makes a run (Fr about 1.1).
+ML_UNITS_PER_S = 12.3
 ML_V_HALF, ML_V_WIDTH = 0.0, 0.04  # activation map of a Morris-Lecar cell (voltage units)
 HOPF_WIDTH = 0.1  # activation map of a Hopf oscillator (units of y)
 MATSUOKA_PEAK = 4.0  # usual peak output of a calibrated ankle neuron (r = 8)
