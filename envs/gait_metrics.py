@@ -15,10 +15,15 @@ Definitions (over the analysis window, after the settling period):
 - double support / flight: fraction of the time with both / neither foot in contact;
 - distance, mean speed: centre-of-mass x travelled and divided by the window length;
 - footfalls per stride of a foot: its touchdowns x stride period / window length (1 when every
-  stride has one touchdown of that foot).
+  stride has one touchdown of that foot);
+- ankle excursion in stance (given the ankle angles): for every complete stance phase of a foot
+  (touchdown to lift-off, both inside the window), the range max - min of that foot's ankle
+  angle; the median over the stance phases of both feet, in degrees. A rigid ankle (flexor and
+  extensor co-active, or no drive) keeps it small; an ankle that rolls over the foot and pushes
+  off (plantarflexes) during the stance makes it large.
 Physical gait (from these numbers alone): "none" when fallen, or with fewer than 3 touchdowns
 per foot; otherwise the first gait of :data:`envs.criteria.CRITERIA` whose pattern (lag, duty,
-double support, flight) the numbers meet, else "none".
+double support, flight, ankle excursion for the two-legged gaits) the numbers meet, else "none".
 """
 from __future__ import annotations
 
@@ -91,6 +96,9 @@ class GaitMetrics:
     # Touchdowns of each foot per stride period over the window: 1 for a regular gait; more
     # when a foot stutters (extra touchdowns), fewer when it skips strides.
     footfalls_per_stride: dict = None
+    # Median range of the ankle angle over the complete stance phases (deg); NaN without
+    # ankle angles or without a complete stance phase.
+    ankle_excursion_deg: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -111,6 +119,20 @@ def lr_lag(td_left: np.ndarray, td_right: np.ndarray, period: float) -> float:
     return float((np.angle(np.mean(np.exp(1j * ang))) / (2 * np.pi)) % 1.0)
 
 
+def ankle_excursion(t: np.ndarray, stance: np.ndarray, ankle: np.ndarray) -> float:
+    """Median over the complete stance phases of both feet of the ankle angle's range (deg).
+
+    stance: (T, 2) debounced contact; ankle: (T, 2) ankle angles (rad). A stance phase cut by
+    the window's start or end is not complete and does not count."""
+    ranges = []
+    for i in range(stance.shape[1]):
+        for a, b in runs(stance[:, i]):
+            if a > 0 and b < len(t) and b - a >= 2:
+                q = ankle[a:b, i]
+                ranges.append(float(np.degrees(q.max() - q.min())))
+    return float(np.median(ranges)) if ranges else float("nan")
+
+
 def classify_physical(m: GaitMetrics) -> str:
     from .criteria import CRITERIA
 
@@ -125,8 +147,10 @@ def classify_physical(m: GaitMetrics) -> str:
 
 
 def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: float | None = None,
-            settle_s: float = 0.0, min_phase_s: float = MIN_PHASE_S) -> GaitMetrics:
-    """All metrics of a rollout; only samples at t >= settle_s count (fall: any time)."""
+            settle_s: float = 0.0, min_phase_s: float = MIN_PHASE_S,
+            ankle: np.ndarray | None = None) -> GaitMetrics:
+    """All metrics of a rollout; only samples at t >= settle_s count (fall: any time).
+    ankle: (T, 2) left and right ankle angles (rad), for the ankle excursion in stance."""
     t = np.asarray(t, dtype=float)
     contact = np.asarray(contact, dtype=bool)
     com_x = np.asarray(com_x, dtype=float)
@@ -158,7 +182,9 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
         touchdowns={k: v.tolist() for k, v in td.items()},
         liftoffs={k: v.tolist() for k, v in lo.items()}, physical_gait="none",
         footfalls_per_stride={k: len(v) * period / window if window > 0 and np.isfinite(period)
-                              else float("nan") for k, v in td.items()})
+                              else float("nan") for k, v in td.items()},
+        ankle_excursion_deg=(ankle_excursion(ts, cs, np.asarray(ankle, float)[sel])
+                             if ankle is not None and len(ts) > 1 else float("nan")))
     m.physical_gait = classify_physical(m)
     return m
 
@@ -189,6 +215,8 @@ class Biomechanics:
                             short strides alternate (a period-2 bounce)
     stance_work_share       fraction of the positive work done in stance (a leg's work while
                             its foot is on the ground) at the hip, knee and ankle
+    trunk_lean_deg          mean torso pitch over the window (deg, > 0 leaning forward; NaN
+                            when no pitch was given)
     """
 
     froude: float
@@ -201,6 +229,7 @@ class Biomechanics:
     stride_cv: float
     period2_index: float
     stance_work_share: dict
+    trunk_lean_deg: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -233,12 +262,14 @@ def stride_regularity(touchdowns: dict) -> tuple[float, float]:
 def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: np.ndarray,
                  power: np.ndarray, leg_joint: np.ndarray, leg_of: np.ndarray, m: GaitMetrics,
                  leg_length_m: float, mass_kg: float, settle_s: float = 0.0,
-                 min_phase_s: float = MIN_PHASE_S) -> Biomechanics:
+                 min_phase_s: float = MIN_PHASE_S,
+                 pitch: np.ndarray | None = None) -> Biomechanics:
     """Biomechanics of a rollout (see :class:`Biomechanics`).
 
     power (T, n_act) W per actuator; leg_joint (n_act,) in {"hip", "knee", "ankle"} and
     leg_of (n_act,) in {0 (left), 1 (right)}: where each actuator acts. ``m``: the contact
-    metrics of the same window (stride period, touchdowns, speed)."""
+    metrics of the same window (stride period, touchdowns, speed). pitch (T,): torso pitch
+    (rad, > 0 forward), for the trunk lean."""
     t = np.asarray(t, float)
     sel = t >= settle_s
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
@@ -269,4 +300,6 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         apex_height_m=apex_height(np.asarray(com_z, float)[sel], flight), stride_cv=cv,
         period2_index=p2,
         stance_work_share={j: (w / total if total > 0 else float("nan"))
-                           for j, w in stance_work.items()})
+                           for j, w in stance_work.items()},
+        trunk_lean_deg=(float(np.degrees(np.mean(np.asarray(pitch, float)[sel])))
+                        if pitch is not None and sel.any() else float("nan")))

@@ -47,6 +47,7 @@ class Validation:
             "stride_period_s": m.stride_period_s, "cpg_period_s": _cpg_period_s(self.network),
             "distance_m": m.distance_m, "speed_mps": m.speed_mps,
             "footfalls_per_stride": m.footfalls_per_stride,
+            "ankle_excursion_deg": m.ankle_excursion_deg,
             "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
         }
         if self.biomech is not None:
@@ -87,14 +88,16 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
     """Metrics and verdicts of a recording over [settle_s, t_end]."""
     fell_at = rec.fell_at if rec.unstable is None else (rec.t[-1] if len(rec.t) else 0.0)
     sel = rec.t <= (np.inf if t_end is None else t_end)
-    m = measure(rec.t[sel], rec.contact[sel], rec.com_x[sel], fell_at, settle_s=settle_s)
+    m = measure(rec.t[sel], rec.contact[sel], rec.com_x[sel], fell_at, settle_s=settle_s,
+                ankle=rec.joints[sel][:, [2, 5]])
     steady = sel & (rec.t >= settle_s)
     cpg_name = classify(rec.t[steady], rec.cpg_v[steady])[0] if steady.sum() > 16 else "none"
     from .biped import body_constants
 
     leg, mass, joint, side = body_constants(rec.xml_path)
     bio = biomechanics(rec.t[sel], rec.contact[sel], rec.com_x[sel], rec.com_z[sel],
-                       rec.power[sel], joint, side, m, leg, mass, settle_s)
+                       rec.power[sel], joint, side, m, leg, mass, settle_s,
+                       pitch=rec.torso_pitch[sel])
     return Validation(network, gait, rec, m, cpg_name, settle_s, ankle_drive, bio)
 
 

@@ -18,12 +18,21 @@ def series(period, duty, lag, speed=1.0):
     return c, speed * T
 
 
-@pytest.mark.parametrize("period,duty,lag,want", [
-    (1.0, 0.65, 0.5, "walk"), (0.7, 0.35, 0.5, "run"), (0.8, 0.55, 0.0, "jump"),
-    (0.6, 0.3, 0.0, "hop")])
-def test_known_gaits(period, duty, lag, want):
+def ankle_wave(period, amplitude_deg):
+    """Ankle angles (T, 2) that swing by ``amplitude_deg`` peak to peak once per stride."""
+    a = 0.5 * np.radians(amplitude_deg) * np.sin(2 * np.pi * T / period)
+    return np.stack([a, a], axis=1)
+
+
+@pytest.mark.parametrize("period,duty,lag,ankle_deg,want", [
+    (1.0, 0.65, 0.5, 30.0, "walk"), (0.7, 0.35, 0.5, 30.0, "run"),
+    (0.8, 0.55, 0.0, 40.0, "jump"), (0.6, 0.55, 0.0, 6.0, "hop"),
+    (0.6, 0.3, 0.0, 40.0, "jump"), (0.8, 0.7, 0.0, 6.0, "hop")])
+def test_known_gaits(period, duty, lag, ankle_deg, want):
+    """The two-legged gaits are told apart by the ankle, never by the duty factor: a short-
+    contact bounce whose ankle rotates is a jump, a long-contact one with a stiff ankle a hop."""
     c, x = series(period, duty, lag)
-    m = gm.measure(T, c, x, settle_s=2.0)
+    m = gm.measure(T, c, x, settle_s=2.0, ankle=ankle_wave(period, ankle_deg))
     assert m.stride_period_s == pytest.approx(period, abs=2 * DT)
     for leg in ("left", "right"):
         assert m.duty_factor[leg] == pytest.approx(duty, abs=0.01)
@@ -37,6 +46,21 @@ def test_known_gaits(period, duty, lag, want):
     assert m.speed_mps == pytest.approx(1.0, rel=1e-3)
     assert m.distance_m == pytest.approx(18.0, abs=0.01)
     assert m.physical_gait == want
+
+
+def test_ankle_excursion_in_stance_by_construction():
+    """The ankle goes linearly from -a to +a over each stance and back in the air: the range
+    in every complete stance is 2a; stances cut by the window do not count; no ankle, NaN."""
+    period, duty, a = 0.8, 0.5, np.radians(12.0)
+    c, x = series(period, duty, 0.0)
+    ph = (T / period) % 1.0
+    q = np.where(ph < duty, -a + 2 * a * ph / duty, a - 2 * a * (ph - duty) / (1 - duty))
+    m = gm.measure(T, c, x, settle_s=2.0, ankle=np.stack([q, 0.5 * q], axis=1))
+    # left 24 deg, right 12 deg in every stance: the median over both feet's stances
+    assert m.ankle_excursion_deg == pytest.approx(18.0, abs=0.5)
+    cut = gm.ankle_excursion(T[:100], c[:100], np.stack([q, q], axis=1)[:100])
+    assert np.isnan(cut)  # 0.2 s: one stance, cut by the window's start
+    assert np.isnan(gm.measure(T, c, x, settle_s=2.0).ankle_excursion_deg)
 
 
 def test_one_leg_hopping_while_the_other_taps_is_not_a_hop():
