@@ -36,8 +36,8 @@ def run_demo(out: str = "out/demo", seconds: float = 20.0, video_seconds: float 
     with ResultDir(out) as rd:
         summaries = _demo(rd, seconds, video_seconds, progress)
         rd.commit()
-    print(f"\nwrote {out}/: README.md, summary.json, demo.rrd, <gait>.mp4, <gait>_gait.png, "
-          f"<gait>_signals.png, <gait>_frame.png, cpg_signals.png")
+    print(f"\nwrote {out}/: README.md, summary.json, demo.rrd, <gait>.mp4, <gait>_chrono.png, "
+          f"<gait>_gait.png, <gait>_signals.png, <gait>_frame.png, cpg_signals.png")
     return summaries
 
 
@@ -49,6 +49,7 @@ def _demo(rd: ResultDir, seconds: float, video_seconds: float, progress: bool) -
     from envs.record import write_rrd
     from envs.render import (FrameRenderer, gait_cycle_picture, gait_diagram, render_video,
                              signals_picture)
+    from envs.chrono import chrono_title, chronophotograph
     from envs.validate import metrics_table, validate
 
     steps = ["CPG reproduction"] + [f"physics: {g}" for g in ml.PRIMARY_GAITS] + ["rerun log"]
@@ -76,6 +77,8 @@ def _demo(rd: ResultDir, seconds: float, video_seconds: float, progress: bool) -
         gait_diagram(v.recording, rd.path(f"{g}_gait.png"), v.metrics, f"{g} ({src})")
         gait_cycle_picture(v.recording, v.metrics, rd.path(f"{g}_cycle.png"), f"{g} ({src})")
         signals_picture(v.recording, rd.path(f"{g}_signals.png"), f"{g} ({src})")
+        chronophotograph(v.recording, rd.path(f"{g}_chrono.png"), v.metrics,
+                         chrono_title(f"{g} preset ({src})", v), period_s=s["cpg_period_s"])
         k = int(np.searchsorted(v.recording.t, min(3.0, v.recording.t[-1])))
         with FrameRenderer(480, 360) as fr:
             frame = fr.frame(v.recording.qpos[k], v.recording.contact[k])
@@ -103,6 +106,7 @@ def _demo(rd: ResultDir, seconds: float, video_seconds: float, progress: bool) -
           "classifier agreeing.", "", "```", phys_table, "```", ""]
     for g in ml.PRIMARY_GAITS:
         md += [f"### {g} (weights: {summaries[g]['weights_source']})", "",
+               f"![{g} chronophotograph]({g}_chrono.png)", "",
                f"![{g}]({g}_frame.png) ![{g} gait diagram]({g}_gait.png)", "",
                f"Video: [{g}.mp4]({g}.mp4), signals: [{g}_signals.png]({g}_signals.png)", ""]
     md += ["Rerun recording of all four: `rerun demo.rrd`.", ""]
