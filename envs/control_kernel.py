@@ -23,7 +23,7 @@ from numba import njit
 SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
-           "kp_air", "kd_knee", "push", "swing_rest")
+           "kp_air", "kd_knee", "push", "swing_rest", "x_clear")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -40,7 +40,8 @@ S_LAST_GROUND, S_WAS_GROUND, S_PUSHED, S_SWUNG, S_MODE = 0, 2, 4, 6, 8
 # kappa (flexor-extensor co-activation).
 S_LAST_T, S_C_LR, S_V_L, S_V_R, S_SYNC, S_C_FE, S_V_F, S_V_E, S_COACT = 10, 11, 12, 13, 14, 15, 16, 17, 18
 S_GROUNDED_IN_BURST = 19  # pair: the leg stood on the ground during its present burst
-S_SIZE = 21
+S_AIRBORNE, S_SWING_DONE = 21, 23  # pairs: the swinging foot has left the ground; lifted in this drive
+S_SIZE = 25
 TAU_FEATURE = 0.5  # s: time constant of those running averages
 # Leg modes (S_MODE), for recordings and tests.
 MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
@@ -57,11 +58,23 @@ CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the groun
 FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (biped.xml)
 
 
+FEATURE_PRIOR = 0.3  # mean square activation of a cell that bursts a third of its cycle
+SIGMA_LIFT = 0.4  # a leg lifts on its own only in a rhythm whose legs alternate (sigma below)
+
+
 def new_state() -> np.ndarray:
     s = np.zeros(S_SIZE)
     s[S_LAST_GROUND:S_LAST_GROUND + 2] = 0.0  # the body starts standing on both feet
     s[S_WAS_GROUND:S_WAS_GROUND + 2] = 1.0
     s[S_LAST_T] = -1.0
+    # The running averages start from a neutral prior, as if the cells had burst with a
+    # correlation of one half: sigma = kappa = 0.5 when the body starts. The controller has
+    # no opinion about the rhythm until the CPG shows it (within about TAU_FEATURE), and no
+    # leg lifts on its own before the CPG's legs are seen to alternate (sigma < SIGMA_LIFT).
+    s[S_V_L] = s[S_V_R] = FEATURE_PRIOR
+    s[S_C_LR] = 0.5 * FEATURE_PRIOR
+    s[S_V_F] = s[S_V_E] = 2.0 * FEATURE_PRIOR
+    s[S_C_FE] = FEATURE_PRIOR
     return s
 
 
@@ -127,9 +140,9 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest) = (
+     swing_rest, x_clear) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
-        G[14], G[15], G[16], G[17], G[18], G[19], G[20])
+        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21])
     # Swing drive: own flexor, the other leg's extensor (crossed), or the silence of the own
     # extensor alone (swing_rest), all while the own extensor is silent.
     for i in range(2):
@@ -142,6 +155,7 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
     pitch_rate = -qvel[ix[IX_ROOTY_V]]
     com_x = sens[ix[IX_COM]]
     com_v = sens[ix[IX_COMVEL]]
+    hip_x = xpos[ix[IX_TORSO], 0]
     ground = np.empty(2, dtype=np.bool_)
     thigh = np.empty(2)
     thigh_rate = np.empty(2)
@@ -158,17 +172,25 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
         knee_rate[i] = qvel[ix[IX_KNEE_V + i]]
         foot_x[i] = xpos[ix[IX_FOOT + i], 0] + FOOT_CENTRE_X
 
-    # Latches, one per leg, that follow the CPG's bursts: a leg pushes once per extensor burst
-    # (a landing inside the same burst is absorbed) and lifts once per swing. A leg has taken
-    # off when it is off the ground after standing in this burst while the other leg is not
-    # still pushing on the ground (a foot that rolls off while its partner pushes has not).
+    # Latches, one per leg, that follow the CPG's bursts, never a clock.
+    # "pushed": the leg took off during its extensor burst (it stood on the ground in this
+    # burst and is now off it while the other leg is not still pushing on the ground); a
+    # landing in the same burst is absorbed, not pushed again. Cleared when the burst ends.
+    # "swing": the leg was lifted by its swing drive (it stood, the drive came on, and the
+    # other leg stood on the ground with its stance command and without a swing drive of its
+    # own, in a rhythm whose legs alternate (sigma < SIGMA_LIFT): a leg never lifts away the only
+    # support, and a synchronous rhythm - a jump's flexor burst, or a walk network's
+    # transient through in-phase bursts - lifts no leg on its own: both legs leave the
+    # ground together, by their push); it swings until its foot lands again,
+    # after having left the ground, when the
+    # drive is over, or x_clear ahead of the hip (where the swing stops tucking; a scuff
+    # behind that in mid-swing is not a landing), or with the other foot off the ground.
     stance_cmd = np.empty(2, dtype=np.bool_)
     for i in range(2):
         stance_cmd[i] = e[i] >= e_on
     for i in range(2):
         j = 1 - i
         if stance_cmd[i]:
-            S[S_SWUNG + i] = 0.0
             if ground[i]:
                 S[S_GROUNDED_IN_BURST + i] = 1.0
             elif S[S_GROUNDED_IN_BURST + i] > 0.5 and not (ground[j] and stance_cmd[j]):
@@ -176,22 +198,35 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
         else:
             S[S_PUSHED + i] = 0.0
             S[S_GROUNDED_IN_BURST + i] = 0.0
-            if not ground[i] and S[S_WAS_GROUND + i] > 0.5:
+    for i in range(2):
+        j = 1 - i
+        if S[S_SWUNG + i] < 0.5:
+            if (ground[i] and g[i] > 0.5 and ground[j] and stance_cmd[j] and g[j] < 0.5
+                    and sigma < SIGMA_LIFT and S[S_SWING_DONE + i] < 0.5):
                 S[S_SWUNG + i] = 1.0
+                S[S_AIRBORNE + i] = 0.0
+                S[S_SWING_DONE + i] = 1.0
+        else:
+            if not ground[i]:
+                S[S_AIRBORNE + i] = 1.0
+            elif S[S_AIRBORNE + i] > 0.5 and (g[i] < 0.5 or foot_x[i] > hip_x + x_clear
+                                               or not ground[j]):
+                S[S_SWUNG + i] = 0.0
+        if g[i] < 0.5:  # one lift per swing drive
+            S[S_SWING_DONE + i] = 0.0
     for i in range(2):
         S[S_WAS_GROUND + i] = 1.0 if ground[i] else 0.0
 
-    # Modes: a grounded leg lifts into swing only while the other leg carries the body; a foot
-    # that merely unloads (no swing, the other foot down) keeps its support behaviour.
+    # Modes: a swinging leg is in the air (or lifting, its foot still down); any other leg is
+    # a support leg on the ground and in the air otherwise (it prepares to land).
     mode = np.empty(2)
     n_support = 0
     sup_x = 0.0
     for i in range(2):
-        j = 1 - i
-        if not ground[i] and (S[S_SWUNG + i] > 0.5 or not ground[j]):
+        if S[S_SWUNG + i] > 0.5:
+            mode[i] = MODE_LIFT if ground[i] else MODE_AIR
+        elif not ground[i]:
             mode[i] = MODE_AIR
-        elif ground[i] and g[i] > 0.5 and S[S_SWUNG + i] < 0.5 and ground[j] and stance_cmd[j]:
-            mode[i] = MODE_LIFT
         else:
             mode[i] = MODE_SUPPORT
             n_support += 1
@@ -240,7 +275,10 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
             kp = kp_knee + (kp_push - kp_knee) * drive
             k = kp * (target - knee[i]) - kd_knee * knee_rate[i] + push * drive
         else:
-            target = knee_land + (knee_swing - knee_land) * g[i]
+            # the swing drive tucks the leg while its foot is behind the hip (clearance); once
+            # the foot is x_clear ahead of it the knee extends to land
+            behind = _clip01((hip_x + x_clear - foot_x[i]) / 0.05)
+            target = knee_land + (knee_swing - knee_land) * g[i] * behind
             k = kp_air * (target - knee[i]) - kd_knee * knee_rate[i]
         u[4 + i] = _clip1(tau_hip[i])
         u[6 + i] = _clip1(k)

@@ -1,8 +1,9 @@
 """The one controller: any network's four ankle cells plus the body's sensors -> 8 controls.
 
 It never receives a gait name, a preset name or a classifier's verdict, and it has one
-parameter set (:data:`CONTROL`) for every gait and every network. Everything that differs
-between gaits comes from the CPG's activations, tick by tick.
+parameter set (:data:`CONTROL`, read from the data file :data:`GAINS_FILE` that
+``cpgbiped tune`` writes) for every gait and every network. Everything that differs between
+gaits comes from the CPG's activations, tick by tick.
 
 Per control tick (every ``control_every`` physics steps; ctrl held in between):
 
@@ -13,8 +14,7 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    Per leg i (j the other leg): flexor f_i = a_iF, extensor e_i = a_iE,
    - swing drive     g_i = (1 - e_i) clip(w_flex f_i + w_cross e_j + swing_rest, 0, 1)
      (the leg's own flexor burst, or the other leg's extensor burst - a crossed extension -
-     or, by the blended swing_rest, the mere silence of its own extensor: the leg stays
-     tucked until its next burst, which is when it lands),
+     or, by the blended swing_rest, the mere silence of its own extensor),
    - stance command  e_i >= e_on,
    and two features of the rhythm, measured online from the CPG signals (<.> running averages
    with a time constant of 0.5 s), both in [0, 1]:
@@ -22,6 +22,8 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
              (1 in phase, 0 in antiphase);
      kappa = <f_L e_L + f_R e_R> / sqrt(<f_L^2 + f_R^2> <e_L^2 + e_R^2>)   flexor-extensor
              co-activation (1 co-active: a stiff ankle; 0 alternating: the ankle rotates).
+   The averages start from a neutral prior (sigma = kappa = 0.5 when the body starts: the
+   controller has no opinion about the rhythm until the CPG shows it).
    The balance and pattern gains (:class:`Corner`: reflex, torso, foot placement, knee) vary
    continuously with them, bilinearly between their values at the four corners of the
    (sigma, kappa) square:
@@ -31,18 +33,21 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    between theirs. The ankle gain, the swing wiring (e_on, w_flex, w_cross) and contact_hold
    are shared by all. Nothing depends on a name.
 2. Contacts and modes. A foot is on the ground while its contact force exceeds 1 N or did
-   within the last ``contact_hold`` s. Each leg is in one mode:
-   - air: its foot is off the ground and the leg swings (it lifted in this swing) or the
-     other foot is off the ground too;
-   - lift: on the ground, g_i > 0.5, not yet lifted in this swing, and the other leg is on the
-     ground with its stance command (a leg never lifts away the only support);
-   - support: otherwise (on the ground, or a foot that merely unloads while the other one
-     stands).
-   Two latches per leg follow the CPG's bursts, never a clock: "pushed" (the leg took off
-   during its extensor burst: it stood on the ground in this burst and is now off it while
-   the other leg is not still pushing on the ground; a landing in the same burst is absorbed,
-   not pushed again) and "swung" (the leg left the ground during its swing; a landing before
-   its next burst stays down). Both clear when the burst state changes.
+   within the last ``contact_hold`` s. A leg *swings* from the moment its swing drive lifts
+   it - g_i > 0.5 while it stands, the other leg stands with its stance command and no swing
+   drive of its own (a leg never lifts away the only support), in a rhythm whose legs
+   alternate (sigma < SIGMA_LIFT = 0.4: in a synchronous rhythm no leg lifts on its own, both
+   leave the ground together by their push), once per swing drive - until its foot lands
+   again after having left the ground, when the drive is over or x_clear ahead of the hip (a
+   scuff behind that is not a landing) or with the other foot off the ground. Each leg is in
+   one mode:
+   - lift: swinging, its foot still on the ground;
+   - air: swinging, or any foot off the ground (it prepares to land);
+   - support: otherwise.
+   A second latch, "pushed", follows the extensor burst: the leg took off during its burst
+   (it stood on the ground in this burst and is now off it while the other leg is not still
+   pushing on the ground); a landing in the same burst is absorbed, not pushed again. It
+   clears when the burst ends.
 3. Ankles: u_muscle = ankle_gain a (each muscle its own cell's activation; one gain for every
    gait and network). A balance reflex adds to it on the ground (never replaces it):
    b = k_ax (x_com - x_sup) + k_av v_com with x_sup the mean centre of the support feet;
@@ -61,9 +66,11 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        tau = kp (target - q) - kd_knee q_rate + push d_i
        (the extensor burst extends the leg - the push-off; outside it the knee yields to a
        crouch that absorbs the landing and loads the next push);
-   air and lift: target knee_land + (knee_swing - knee_land) g_i,
-       tau = kp_air (target - q) - kd_knee q_rate
-       (the swing drive tucks the leg; without it the leg extends to land).
+   air and lift: target knee_land + (knee_swing - knee_land) g_i h_i,
+       tau = kp_air (target - q) - kd_knee q_rate,
+       h_i = clip((x_hip + x_clear - x_foot_i) / 0.05, 0, 1)
+       (the swing drive tucks the leg while its foot is behind x_clear ahead of the hip - the
+       clearance; past that, or without the drive, the leg extends to land).
 
 What makes the gaits differ is the CPG: left-right extensors in antiphase give alternating
 support (walk, run), in phase both legs push and fly together (jump, hop); synchrony (sigma)
@@ -77,6 +84,7 @@ from the torso's up axis, > 0 leaning forward.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -91,65 +99,47 @@ from . import control_kernel as kernel
 class Corner:
     """The blended gains at one corner of the (sigma, kappa) square; units as in the module
     docstring (angles rad, torques as fractions of the gear, reflex in activation per m and
-    per m/s)."""
+    per m/s, x_clear in m)."""
 
-    k_ax: float = 0.0  # ankle balance reflex: activation per m of COM ahead of the support
-    k_av: float = 0.0  # ... per m/s of COM velocity
-    kp_t: float = 1.069  # torso pitch through the support hips
-    kd_t: float = 0.4888
-    pitch_d: float = 0.185  # torso lean target (rad, forward)
-    theta0: float = 0.1523  # foot placement: thigh angle target (rad from vertical, forward)
-    c_v: float = 0.2233  # ... per m/s of COM speed
-    c_d: float = 0.4651  # ... per m of COM ahead of the support
-    kp_sw: float = 1.09  # hip gains of a leg placing its foot
-    kd_sw: float = 0.15
-    kf_t: float = 0.0  # in flight: hip torque from the torso pitch error (fraction)
-    knee_ext: float = -0.1806  # knee target in the extensor burst on the ground (push)
-    knee_crouch: float = -0.3  # knee target on the ground outside the burst
-    knee_swing: float = -0.9822  # knee target with full swing drive
-    knee_land: float = -0.1806  # knee target in the air without swing drive
-    kp_knee: float = 1.007  # knee stiffness on the ground outside the burst (gear per rad)
-    kp_push: float = 1.007  # ... on the ground in the burst (push)
-    kp_air: float = 1.007  # ... in the air and lifting
-    kd_knee: float = 0.1
-    push: float = 0.9162  # knee extension torque per unit of burst drive
-    swing_rest: float = 0.0  # swing drive while the leg's own extensor is silent
+    k_ax: float  # ankle balance reflex: activation per m of COM ahead of the support
+    k_av: float  # ... per m/s of COM velocity
+    kp_t: float  # torso pitch through the support hips
+    kd_t: float
+    pitch_d: float  # torso lean target (rad, forward)
+    theta0: float  # foot placement: thigh angle target (rad from vertical, forward)
+    c_v: float  # ... per m/s of COM speed
+    c_d: float  # ... per m of COM ahead of the support
+    kp_sw: float  # hip gains of a leg placing its foot
+    kd_sw: float
+    kf_t: float  # in flight: hip torque from the torso pitch error (fraction)
+    knee_ext: float  # knee target in the extensor burst on the ground (push)
+    knee_crouch: float  # knee target on the ground outside the burst
+    knee_swing: float  # knee target with full swing drive
+    knee_land: float  # knee target in the air without swing drive
+    kp_knee: float  # knee stiffness on the ground outside the burst (gear per rad)
+    kp_push: float  # ... on the ground in the burst (push)
+    kp_air: float  # ... in the air and lifting
+    kd_knee: float
+    push: float  # knee extension torque per unit of burst drive
+    swing_rest: float  # swing drive while the leg's own extensor is silent
+    x_clear: float  # m: a swinging foot this far ahead of the hip stops tucking and may land
 
 
 @dataclass(frozen=True)
 class ControlParams:
     """The one controller's parameters: shared ones, and the blended gains at the four corners
-    of the (sigma, kappa) square (see the module docstring)."""
+    of the (sigma, kappa) square (see the module docstring). The values live in a data file,
+    :data:`GAINS_FILE`, written by ``cpgbiped tune`` with the command and seed that made them."""
 
-    ankle_gain: float = 0.25  # ankle muscle ctrl = ankle_gain * CPG activation
-    e_on: float = 0.5  # extensor activation from which a leg is commanded to stance
-    w_flex: float = 1.0  # swing drive from the leg's own flexor
-    w_cross: float = 1.0  # swing drive from the other leg's extensor (crossed extension)
-    contact_hold: float = 0.0  # s: ground contact held this long after the last touch
-    alternating: Corner = Corner(
-        k_ax=6.75843, k_av=1.74423, kp_t=5.81779, kd_t=0.435745, pitch_d=0.257448,
-        theta0=0.377273, c_v=0.0428596, c_d=0.408213, kp_sw=1.47707, kd_sw=0.0568613,
-        kf_t=-0.768358, knee_ext=-0.369504, knee_crouch=-0.264224, knee_swing=-0.308863,
-        knee_land=-0.356837, kp_knee=1.65299, kp_push=0.862569, kp_air=3.36174,
-        kd_knee=0.0426775, push=0.241425)  # sigma = 0, kappa = 0
-    alternating_coactive: Corner = Corner(
-        k_ax=23.8134, k_av=0.746165, kp_t=5.8726, kd_t=0.63193, pitch_d=0.26403, theta0=0.471598,
-        c_v=0.0445525, c_d=0.529711, kp_sw=1.2997, kd_sw=0.0631488, kf_t=-0.0997662,
-        knee_ext=-0.443033, knee_crouch=-0.303713, knee_swing=-0.679225, knee_land=-0.315828,
-        kp_knee=1.07473, kp_push=1.50687, kp_air=0.885357, kd_knee=0.101894, push=0.555107,
-        swing_rest=0.144525)  # sigma = 0, kappa = 1
-    synchronous: Corner = Corner(
-        k_ax=15.405, k_av=1.65213, kp_t=3.79622, kd_t=0.499886, pitch_d=0.250948,
-        theta0=0.0418366, c_v=0.21664, c_d=0.16645, kp_sw=3.84253, kd_sw=0.0300601,
-        kf_t=-0.946302, knee_ext=-0.0502864, knee_crouch=-0.310951,
-        knee_swing=-0.394472, knee_land=-0.219799, kp_knee=2.21419, kp_push=4.89344,
-        kp_air=2.43328, kd_knee=0.0536399, push=0.20081)  # sigma = 1, kappa = 0
-    synchronous_coactive: Corner = Corner(
-        k_ax=0.592679, k_av=4.5132, kp_t=4.11062, kd_t=0.258228, pitch_d=0.197643,
-        theta0=0.340126, c_v=0.211234, c_d=0.268493, kp_sw=3.13671, kd_sw=0.382845,
-        kf_t=-0.195603, knee_ext=-0.31993, knee_crouch=-0.472452, knee_swing=-0.634746,
-        knee_land=-0.159711, kp_knee=0.536043, kp_push=4.992, kp_air=3.6832,
-        kd_knee=0.0525718, push=0.793964)  # sigma = 1, kappa = 1
+    ankle_gain: float  # ankle muscle ctrl = ankle_gain * CPG activation
+    e_on: float  # extensor activation from which a leg is commanded to stance
+    w_flex: float  # swing drive from the leg's own flexor
+    w_cross: float  # swing drive from the other leg's extensor (crossed extension)
+    contact_hold: float  # s: ground contact held this long after the last touch
+    alternating: Corner  # sigma = 0, kappa = 0 (the walk's rhythm)
+    alternating_coactive: Corner  # sigma = 0, kappa = 1 (the run's)
+    synchronous: Corner  # sigma = 1, kappa = 0 (the two-legged jump's)
+    synchronous_coactive: Corner  # sigma = 1, kappa = 1 (the two-legged hop's)
 
     def corner(self, name: str) -> Corner:
         return getattr(self, name)
@@ -163,8 +153,53 @@ if tuple(f.name for f in fields(Corner)) != kernel.BLENDED or tuple(
         f.name for f in fields(ControlParams))[kernel.N_SHARED:] != kernel.CORNERS:
     raise ImportError("ControlParams and envs.control_kernel's parameter layout disagree")
 
+# The gains file: the controller's parameters and, for each part, the tuning run that made it.
+GAINS_FILE = Path(__file__).with_name("gains.json")
+GAINS_FORMAT = "cpgbiped.gains/1"
+
+
+def params_to_dict(p: ControlParams) -> dict:
+    """{"shared": {name: value}, "corners": {corner: {gain: value}}} (plain floats)."""
+    return {"shared": {n: float(getattr(p, n)) for n in kernel.SHARED},
+            "corners": {c: {g: float(getattr(p.corner(c), g)) for g in kernel.BLENDED}
+                        for c in kernel.CORNERS}}
+
+
+def params_from_dict(d: dict, what: str = "gains") -> ControlParams:
+    """The inverse of :func:`params_to_dict`; every name must be there, finite, and known."""
+    try:
+        shared, corners = d["shared"], d["corners"]
+        if set(shared) != set(kernel.SHARED) or set(corners) != set(kernel.CORNERS) or any(
+                set(corners[c]) != set(kernel.BLENDED) for c in kernel.CORNERS):
+            raise KeyError("names")
+        vals = [float(shared[n]) for n in kernel.SHARED] + [
+            float(corners[c][g]) for c in kernel.CORNERS for g in kernel.BLENDED]
+    except (KeyError, TypeError, ValueError) as e:
+        raise InputError(f"{what}: not a complete set of the controller's parameters "
+                         f"({type(e).__name__}: {e})") from None
+    if not np.all(np.isfinite(vals)):
+        raise InputError(f"{what}: the controller's parameters must be finite numbers")
+    return ControlParams(**{n: float(shared[n]) for n in kernel.SHARED},
+                         **{c: Corner(**{g: float(corners[c][g]) for g in kernel.BLENDED})
+                            for c in kernel.CORNERS})
+
+
+def read_gains(path: str | Path = GAINS_FILE) -> tuple[ControlParams, list]:
+    """(parameters, provenance) of a gains file (:data:`GAINS_FORMAT`)."""
+    import json
+
+    try:
+        d = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise InputError(f"cannot read the gains file {str(path)!r}: {e}") from None
+    if not isinstance(d, dict) or d.get("format") != GAINS_FORMAT:
+        raise InputError(f"{str(path)!r} is not a gains file (format {GAINS_FORMAT})")
+    prov = d.get("provenance", [])
+    return params_from_dict(d, str(path)), prov if isinstance(prov, list) else []
+
+
 # The one parameter set, for every gait and every network.
-CONTROL = ControlParams()
+CONTROL = read_gains()[0]
 
 
 @dataclass
@@ -206,6 +241,20 @@ def params_array(p: ControlParams) -> np.ndarray:
     for g in kernel.BLENDED:
         out += [float(getattr(p.corner(c), g)) for c in kernel.CORNERS]
     return np.array(out)
+
+
+def params_from_array(P: np.ndarray) -> ControlParams:
+    """The inverse of :func:`params_array`."""
+    P = np.asarray(P, float)
+    if P.shape != (kernel.P_SIZE,):
+        raise InputError(f"a controller parameter array has {kernel.P_SIZE} numbers, "
+                         f"got shape {P.shape}")
+    shared = dict(zip(kernel.SHARED, P[:kernel.N_SHARED].tolist()))
+    corners = {c: {} for c in kernel.CORNERS}
+    for n, g in enumerate(kernel.BLENDED):
+        for k, c in enumerate(kernel.CORNERS):
+            corners[c][g] = float(P[kernel.N_SHARED + 4 * n + k])
+    return params_from_dict({"shared": shared, "corners": corners}, "parameter array")
 
 
 def without_ankle_drive(p: ControlParams) -> ControlParams:

@@ -68,8 +68,9 @@ def test_ankle_muscles_get_their_cells_at_one_gain():
     sched = cpg_schedule(net, 3.0)
     for params in (CONTROL, without_ankle_drive(CONTROL)):
         c = CPGController(m, d, sched, params)
-        # from t > 0: at t = 0 the controller takes the body as standing on both feet
-        for t in (0.01, 0.37, 1.9):
+        # after the contact hold: at t = 0 the controller takes the body as standing on both
+        # feet, and holds that contact for contact_hold seconds
+        for t in (params.contact_hold + 0.02, 0.37, 1.9):
             u = c(t).copy()
             out = net.outputs(t * net.units_per_s + 1e-9)
             v = out.v[-1]
@@ -87,3 +88,44 @@ def test_the_controller_takes_no_gait_name():
     fields = " ".join(CONTROL.__dataclass_fields__)
     for word in ("gait", "walk", "run", "jump", "hop", "preset", "two_legged"):
         assert word not in fields
+
+
+def standing_run(a: np.ndarray, seconds: float):
+    """The body standing on the floor, driven by the synthetic activations a (T, 4) for
+    ``seconds``; the leg modes and the features of every tick."""
+    m = load_model()
+    d = mujoco.MjData(m)
+    c = CPGController(m, d, synthetic(a))
+    modes, feats = [], []
+    for k in range(int(seconds / (2 * DT))):
+        d.ctrl[:] = c(d.time)
+        modes.append(c.modes)
+        feats.append((c.S[K.S_SYNC], c.S[K.S_COACT]))
+        mujoco.mj_step(m, d, nstep=2)
+    return np.array(modes), np.array(feats)
+
+
+def test_rhythm_features_start_neutral():
+    """The controller has no opinion about the rhythm when the body starts: sigma = kappa =
+    0.5 (within the running averages' epsilon), whatever the first activations are."""
+    t = np.arange(0.0, 1.0, DT)
+    for lags in ((0.0, 0.5, 0.5, 0.0), (0.0, 0.0, 0.0, 0.0)):
+        a = np.stack([square(t, 0.8, lag) for lag in lags], axis=1)
+        _, feats = standing_run(a, 0.01)
+        assert np.allclose(feats[0], 0.5, atol=0.01)
+
+
+def test_a_synchronous_rhythm_lifts_no_leg_on_its_own():
+    """In-phase extensor bursts with the flexors between them (the jump's pattern): every
+    swing drive comes with the other leg's, so no leg is lifted while the other stands; the
+    walk's pattern (legs half a cycle apart) lifts each leg in turn."""
+    t = np.arange(0.0, 3.0, DT)
+    jump = np.stack([square(t, 0.97, lag, 0.38) for lag in (0.5, 0.5, 0.0, 0.0)], axis=1)
+    modes, feats = standing_run(jump, 2.5)
+    assert feats[-1][0] > 0.9  # sigma: synchronous
+    assert not (modes == K.MODE_LIFT).any()
+    walk = np.stack([square(t, 1.07, lag, 0.3) for lag in (0.5, 0.0, 0.0, 0.5)], axis=1)
+    modes, feats = standing_run(walk, 2.5)
+    assert feats[-1][0] < 0.1
+    for leg in range(2):
+        assert (modes[:, leg] == K.MODE_LIFT).any(), leg

@@ -107,8 +107,7 @@ def test_fall_sensors_see_a_body_on_the_floor():
     assert verdicts == [0, 1]
 
 
-@pytest.mark.parametrize("gait", ["walk", "run", "jump", pytest.param("hop", marks=pytest.mark.xfail(
-    strict=True, reason="the one controller's hop: symmetric, duty 0.68, named jump (README)"))])
+@pytest.mark.parametrize("gait", ["walk", "run", "jump", "hop"])
 def test_environment_with_zero_residual_produces_the_gait(gait):
     """The dm_control environment steps the same CPG controller as the validated rollouts:
     with a zero residual action the body stays up and its contacts name its gait."""
@@ -117,14 +116,16 @@ def test_environment_with_zero_residual_produces_the_gait(gait):
 
     env = envs.load(gait, random=1, time_limit=12.0)
     ts = env.reset()
-    t, contact, x, fell_at = [], [], [], None
+    t, contact, x, ankle, fell_at = [], [], [], [], None
     while not ts.last():
         ts = env.step(np.zeros(8))
         ph = env.physics
         t.append(ph.data.time)
         contact.append(ph.foot_contacts())
         x.append(ph.com_x())
+        ankle.append(ph.joint_angles()[[2, 5]])
         if fell_at is None and (ph.torso_height() < FALL_HEIGHT or abs(ph.torso_pitch()) > FALL_PITCH):
             fell_at = t[-1]
-    m = measure(np.array(t), np.array(contact), np.array(x), fell_at, settle_s=2.0)
+    m = measure(np.array(t), np.array(contact), np.array(x), fell_at, settle_s=2.0,
+                ankle=np.array(ankle))
     assert fell_at is None and m.physical_gait == gait, m
