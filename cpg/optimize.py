@@ -293,10 +293,13 @@ def save_checkpoint(path: Path, algorithm, meta: dict) -> None:
             pickle.dump(algorithm, f)
 
 
-def load_checkpoint(path: Path, meta: dict):
+def load_checkpoint(path: Path, meta: dict, algorithm_type=None):
     """The algorithm of a checkpoint written by this run's settings. The header (magic, format
-    version, settings) is checked first; only a matching file is unpickled."""
+    version, settings) is checked first; only a matching file is unpickled. algorithm_type:
+    the class the run uses (default pymoo's NSGA2)."""
     from pymoo.algorithms.moo.nsga2 import NSGA2
+
+    algorithm_type = NSGA2 if algorithm_type is None else algorithm_type
 
     name = str(path)
     try:
@@ -321,17 +324,19 @@ def load_checkpoint(path: Path, meta: dict):
             IndexError, TypeError) as e:
         raise InputError(f"unreadable checkpoint {name!r}: {type(e).__name__}") from None
     pop = getattr(algorithm, "pop", None)
-    if not isinstance(algorithm, NSGA2) or pop is None or np.asarray(pop.get("X")).ndim != 2 \
+    if not isinstance(algorithm, algorithm_type) or pop is None \
+            or np.asarray(pop.get("X")).ndim != 2 \
             or np.asarray(pop.get("X")).shape[1] != meta["n_var"]:
-        raise InputError(f"unreadable checkpoint {name!r}: it does not hold an NSGA-II run of "
-                         f"this problem")
+        raise InputError(f"unreadable checkpoint {name!r}: it does not hold a "
+                         f"{algorithm_type.__name__} run of this problem")
     return algorithm
 
 
 def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None = None,
         on_generation: Callable[[int, int], None] | None = None,
-        stop_after: int | None = None, sampling=None) -> RunResult:
-    """NSGA-II on ``problem``; checkpoints every ``rs.checkpoint_every`` generations.
+        stop_after: int | None = None, sampling=None, algorithm=None) -> RunResult:
+    """NSGA-II (or ``algorithm``, a pymoo algorithm not yet set up) on ``problem``; checkpoints
+    every ``rs.checkpoint_every`` generations.
 
     With an existing checkpoint of the same problem and settings the run resumes from it.
     ``stop_after`` stops after that many generations of this call (to test resuming).
@@ -342,17 +347,19 @@ def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None
             "n_obj": problem.n_obj,
             "xl": problem.xl.tolist(), "xu": problem.xu.tolist(), **asdict(rs),
             "settings": asdict(problem.settings)}
+    if algorithm is not None:
+        meta["algorithm"] = type(algorithm).__name__
     meta.pop("checkpoint_every")
     ckpt = Path(checkpoint) if checkpoint else None
     resumed = None
     if ckpt is not None and ckpt.exists():
-        algorithm = load_checkpoint(ckpt, meta)
+        algorithm = load_checkpoint(ckpt, meta, None if algorithm is None else type(algorithm))
         if hasattr(problem, "restore"):  # state the problem keeps across generations
             problem.restore(algorithm.problem)
         algorithm.problem = problem  # re-attach the evaluator (never pickled)
         resumed = algorithm.n_gen - 1 if algorithm.n_gen else 0
     else:
-        algorithm = _algorithm(rs.pop, sampling)
+        algorithm = _algorithm(rs.pop, sampling) if algorithm is None else algorithm
         algorithm.setup(problem, termination=("n_gen", int(rs.gens)), seed=int(rs.seed),
                         verbose=False)
     done_here = 0

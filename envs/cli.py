@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shlex
 import sys
 import textwrap
 import time
@@ -232,6 +233,10 @@ class _progress:
     def set_description(self, text):
         self._ensure().set_description(text)
 
+    def note(self, text):
+        if self.bar is not None:
+            self.bar.set_postfix_str(text, refresh=False)
+
     def close(self):
         if self.bar is not None:
             self.bar.close()
@@ -286,6 +291,49 @@ def cmd_optimize_physics(a) -> int:
     print(line("paper", p))
     print(f"results in {a.out}/: {gait}_physics.json, {gait}_physics_population.csv, "
           f"{gait}_physics_pareto.csv, {gait}_physics_pareto.png")
+    return 0
+
+
+def cmd_tune(a) -> int:
+    from cpg.optimize import RunSettings
+    from envs.controller import GAINS_FILE
+    from envs.controller_tuning import TuneSettings, check_gaits, tune, variables
+    from envs.trials import DaskRunner, PoolRunner, SerialRunner
+
+    out_dir(a.out)
+    settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
+                            a.conditions, a.sigma)
+    rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
+    start = a.start or str(GAINS_FILE)
+    from envs.controller import read_gains
+
+    read_gains(start)  # a bad starting file is refused before any work
+    args = (settings.seconds, 2.0)
+    if a.dask is not None:
+        runner = DaskRunner(*args, address=None if a.dask == "local" else a.dask)
+    elif a.workers == 1:
+        runner = SerialRunner(*args)
+    else:
+        runner = PoolRunner(*args, workers=a.workers)
+    n_var = len(variables(settings))
+    name = "CMA-ES" if settings.algorithm == "cmaes" else "NSGA-II"
+    bar, cb = _progress(f"{name} over {n_var} gains, {settings.gait}", rs.gens, not a.quiet)
+    command = "cpgbiped " + " ".join(shlex.quote(x) for x in a.argv)
+    try:
+        r = tune(settings, rs, a.out, runner, start=start, command=command, progress=cb,
+                 note=bar.note)
+    finally:
+        bar.close()
+        runner.close()
+    e = r["entry"]
+    print(f"{name} over {n_var} gains ({settings.gait}, search: {settings.search}): "
+          f"cost {e['start_cost']:.3f} at the start, {e['cost']:.3f} at the best point "
+          f"({e['generations_run']} generations, pop {rs.pop}, seed {rs.seed}, "
+          f"{len(e['conditions'])} tuning conditions)")
+    for g in settings.gaits:
+        print(f"  {g}: the best point's rollouts under each condition: {a.out}/tune_conditions.csv")
+    print(f"results in {a.out}/: gains.json (copy it to {GAINS_FILE} to make it the controller's "
+          f"gains), tune_history.csv, tune_conditions.csv")
     return 0
 
 
@@ -472,11 +520,16 @@ def cmd_render(a) -> int:
     gait_diagram(v.recording, stem + "_gait.png", v.metrics, label)
     gait_cycle_picture(v.recording, v.metrics, stem + "_cycle.png", label)
     signals_picture(v.recording, stem + "_signals.png", label)
+    from envs.chrono import chronophotograph, chrono_title
+
+    chronophotograph(v.recording, stem + "_chrono.png", v.metrics, chrono_title(label, v),
+                     period_s=v.summary()["cpg_period_s"])
     if a.rrd:
         from envs.record import write_rrd
 
         write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)}, {a.gait: path})
-    print(f"wrote {path}, {stem}_gait.png, {stem}_cycle.png, {stem}_signals.png"
+    print(f"wrote {path}, {stem}_chrono.png, {stem}_gait.png, {stem}_cycle.png, "
+          f"{stem}_signals.png"
           + (f", {a.rrd}" if a.rrd else ""))
     return 0
 
@@ -606,9 +659,11 @@ def build_parser() -> argparse.ArgumentParser:
         Render a rollout with MuJoCo's off-screen renderer (MUJOCO_GL: osmesa by default,
         egl accepted) to an mp4 (mediapy/ffmpeg), frames taken by simulated time; a side
         camera tracks the torso, foot markers turn green in stance; a strip of the four CPG
-        signals runs below unless --no-signals. Also writes FILE_gait.png (footfall
-        diagram), FILE_cycle.png (joint angles and vertical ground reaction force over the
-        gait cycle, mean +- s.d. over strides) and FILE_signals.png beside the video.""")
+        signals runs below unless --no-signals. Also writes FILE_chrono.png (a
+        chronophotograph: the body's poses over the last two strides on one picture, feet on
+        the ground drawn thick, footprints marked), FILE_gait.png (footfall diagram),
+        FILE_cycle.png (joint angles and vertical ground reaction force over the gait cycle,
+        mean +- s.d. over strides) and FILE_signals.png beside the video.""")
     rollout_args(sp)
     sp.add_argument("--width", type=count_arg(1), default=640)
     sp.add_argument("--height", type=count_arg(1), default=480)
@@ -720,6 +775,54 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", default="out/optimize", help="output folder (default out/optimize)")
     sp.add_argument("--quiet", action="store_true", help="no progress bar")
 
+    sp = add("tune", cmd_tune, "tune the one controller's gains in physics (pymoo)", """\
+        Search the one controller's gains with pymoo: CMA-ES (default) or NSGA-II. The
+        variables are the blended gains at the corners of the (synchrony, co-activation)
+        square that the named gaits' Morris-Lecar presets sit at (--gait walk: the
+        alternating corner; --gait jump,hop: both synchronous corners; --gait all: all
+        four), or with --search shared the parameters every gait shares (ankle gain, swing
+        wiring, contact hold), or both. Each candidate drives each named preset for 2 s of
+        settling plus
+        --seconds under --conditions tuning conditions (random initial CPG states from
+        seeds 1000 and up, other floor frictions, pushes on the torso: disjoint from the
+        conditions the tests and the README report). Its cost comes from the criteria of
+        envs/criteria.py: seconds upright, distance towards the target Froude number (walk,
+        run), the pattern and quality shortfalls, one stride per CPG cycle. The search
+        starts from --start (default: the controller's own gains file) and keeps what it
+        does not search. Writes DIR/gains.json (the gains file with the best values and a
+        provenance entry: command, seed, algorithm, budget, conditions, cost, the SHA-256 of
+        the starting file), DIR/tune_history.csv and DIR/tune_conditions.csv. A checkpoint
+        is written every N generations; the same command resumes after an interrupt, with
+        the result of an uninterrupted run.""")
+    sp.add_argument("--gait", required=True,
+                    help="walk, run, jump, hop, a comma-separated list, or all")
+    sp.add_argument("--search", choices=("corners", "shared", "both"), default="corners",
+                    help="what to search: the named gaits' corners (default), the shared "
+                         "parameters (ankle gain, swing wiring, contact hold; best with "
+                         "--gait all), or both")
+    sp.add_argument("--algorithm", choices=("cmaes", "nsga2"), default="cmaes",
+                    help="CMA-ES (default) or NSGA-II")
+    sp.add_argument("--pop", type=count_arg(4), default=24, help="population size (default 24)")
+    sp.add_argument("--gens", type=count_arg(1), default=100, help="generations (default 100)")
+    sp.add_argument("--seed", type=seed_arg, default=0, help="random seed (default 0)")
+    sp.add_argument("--seconds", type=seconds_arg, default=10.0,
+                    help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
+    sp.add_argument("--conditions", type=count_arg(1), default=6, metavar="N",
+                    help="tuning conditions per candidate (1-16, default 6)")
+    sp.add_argument("--sigma", type=finite_arg, default=0.15,
+                    help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
+                         "first population's spread; default 0.15)")
+    sp.add_argument("--start", default=None, metavar="GAINS.json",
+                    help="gains file to start from (default: the controller's, envs/gains.json)")
+    sp.add_argument("--workers", type=count_arg(1), default=None,
+                    help="rollout processes (default: one per core)")
+    sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",
+                    help="roll out on Dask: a LocalCluster, or the scheduler at tcp://host:port")
+    sp.add_argument("--checkpoint-every", type=count_arg(1), default=5, metavar="N",
+                    help="checkpoint interval in generations (default 5)")
+    sp.add_argument("--out", default="out/tune", help="output folder (default out/tune)")
+    sp.add_argument("--quiet", action="store_true", help="no progress bar")
+
     sp = add("secondary", cmd_secondary, "secondary gaits by symmetry breaking", """\
         From each primary gait's weights (the optimiser's results in --results when present,
         else the paper's), search perturbations of the 12 directed weights that keep one
@@ -765,6 +868,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = [a for a in argv if a != "--debug"]
     try:
         args = build_parser().parse_args(argv)
+        args.argv = argv
         gl = os.environ.get("MUJOCO_GL")
         if gl not in GL_BACKENDS:  # mujoco would refuse to import with a traceback
             return _fail(f"unsupported MUJOCO_GL={gl!r}: use osmesa (default, apt package "

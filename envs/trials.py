@@ -108,6 +108,45 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         apex_height_m=_num(b.apex_height_m), error=rec.unstable)
 
 
+@dataclass(frozen=True)
+class ControlTrial:
+    """One rollout that scores controller gains (``cpgbiped tune``): the Morris-Lecar preset of
+    ``preset`` with its parameters, started from its Table 3 state or from a random one drawn
+    from ``cpg_seed``, driving the body through the controller whose parameter array
+    (:func:`envs.controller.params_array`) is ``control``, under a condition (friction
+    scale, a push (time s, impulse N s))."""
+
+    preset: str
+    control: tuple
+    cpg_seed: int | None = None
+    friction_scale: float = 1.0
+    push: tuple[float, float] | None = None
+
+
+def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SETTLE_S,
+                      stop_on_fall: bool = True) -> dict:
+    """Roll ``trial`` out and return its summary (:meth:`envs.validate.Validation.summary`,
+    the gait named by ``preset``) plus ``survived_s`` (simulated seconds before a fall, the
+    whole rollout otherwise), ``total_s`` and ``cpg_period_s``."""
+    from cpg.network import build
+
+    from .controller import params_from_array
+    from .rollout import rollout
+    from .validate import measure_recording
+
+    total = settle_s + seconds
+    net = build("ml", trial.preset, seed=trial.cpg_seed)
+    rec = rollout(net, total, params_from_array(np.asarray(trial.control, float)),
+                  friction_scale=trial.friction_scale, push=trial.push,
+                  stop_on_fall=stop_on_fall, poses=False)
+    s = measure_recording(net, trial.preset, rec, settle_s).summary()
+    fell = bool(s["fell"]) or rec.unstable is not None
+    s["fell"] = fell
+    s["survived_s"] = (float(rec.t[-1]) if len(rec.t) else 0.0) if fell else total
+    s["total_s"] = total
+    return s
+
+
 def _run_chunk(args) -> list[TrialResult]:
     """A worker's share of a batch. The network's integrator is parallel over its batch; a
     trial integrates one network, and idle threads that spin would take the core from the
@@ -116,7 +155,8 @@ def _run_chunk(args) -> list[TrialResult]:
 
     numba.set_num_threads(1)
     trials, seconds, settle_s, stop_on_fall = args
-    return [run_trial(t, seconds, settle_s, stop_on_fall) for t in trials]
+    return [run_control_trial(t, seconds, settle_s, stop_on_fall) if isinstance(t, ControlTrial)
+            else run_trial(t, seconds, settle_s, stop_on_fall) for t in trials]
 
 
 def chunks(n: int, n_workers: int, per_worker: int = 4) -> list[slice]:

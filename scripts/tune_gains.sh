@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Regenerate the one controller's gains (envs/gains.json) from the hand-set root
+# (envs/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
+# order, each started from the one before. Every run is deterministic (its seed, its tuning
+# conditions), so the chain ends with the committed parameters, bit for bit; the last line
+# checks it. About 70 minutes on 2 cores. Usage:
+#     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
+# then `cp OUT/final/gains.json envs/gains.json` makes the result the controller's gains.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${1:-out/tune_chain}
+mkdir -p "$OUT"
+prev=envs/gains_root.json
+stage() {  # stage NAME ARGS...: one tune run started from the previous stage's gains
+  local name=$1; shift
+  echo "tune_gains: $name: cpgbiped tune $* --start $prev"
+  cpgbiped tune "$@" --pop 24 --start "$prev" --out "$OUT/$name" --quiet
+  prev="$OUT/$name/gains.json"
+}
+stage w1 --gait walk --conditions 2 --gens 300 --seed 1   # bootstrap: the walk corner
+stage j1 --gait jump --conditions 2 --gens 200 --seed 2   # the jump corner
+stage h1 --gait hop --conditions 6 --gens 200 --seed 3    # the hop corner
+stage r1 --gait run --conditions 2 --gens 300 --seed 4    # the run corner
+stage w2 --gait walk --conditions 6 --gens 150 --seed 5   # every corner again, over all six
+stage r2 --gait run --conditions 6 --gens 200 --seed 6    #   conditions (random CPG states
+stage h2 --gait hop --conditions 6 --gens 150 --seed 7    #   through their transients,
+stage j2 --gait jump --conditions 6 --gens 120 --seed 8   #   frictions, pushes)
+stage w3 --gait walk --conditions 6 --gens 120 --seed 9
+rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
+python3 - "$prev" <<'EOF'
+import sys
+from envs.controller import read_gains
+from envs.controller_tuning import params_sha256
+new, _ = read_gains(sys.argv[1])
+old, _ = read_gains("envs/gains.json")
+same = params_sha256(new) == params_sha256(old)
+print("tune_gains: the chain ends with", "the committed gains (identical)" if same
+      else "gains that differ from envs/gains.json")
+sys.exit(0 if same else 1)
+EOF

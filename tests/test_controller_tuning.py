@@ -1,0 +1,186 @@
+"""cpgbiped tune (envs.controller_tuning, cpg.cmaes): the cost ranks rollouts as the criteria
+say, a small run writes a gains file the controller loads, an interrupted run resumes to the
+identical result, the same seed gives the same result, and the tuning conditions never meet
+the conditions the tests report."""
+import json
+import pickle
+
+import numpy as np
+import pytest
+from pymoo.core.problem import Problem
+
+from cpg.cmaes import CMAES
+from cpg.errors import InputError
+from cpg.optimize import RunSettings
+from envs import gait_metrics as gm
+from envs.controller import CONTROL, GAINS_FILE, read_gains
+from envs.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, TuneSettings, check_gaits,
+                                    rollout_cost, target_speed, tune, tuning_conditions,
+                                    variables)
+from envs.criteria import CRITERIA
+from envs.trials import SerialRunner
+
+DT = 0.004
+T = np.arange(0.0, 12.0, DT)
+STRIDE = 1.066
+
+
+def walk_summary(duty=0.62, speed=1.0, fell_at=None, survived=12.0, period=STRIDE):
+    """A clean synthetic walk: antiphase feet with the given duty, at ``speed`` (m/s)."""
+    t = T if fell_at is None else T[T <= fell_at]  # a rollout stops at a fall
+    phase = lambda off: ((t - off) / STRIDE) % 1.0  # noqa: E731
+    c = np.stack([phase(0.0) < duty, phase(0.5 * STRIDE) < duty], axis=1)
+    x = speed * t
+    m = gm.measure(t, c, x, fell_at, settle_s=2.0)
+    s = m.as_dict()
+    fr = speed ** 2 / (9.81 * 0.862)
+    s.update(froude=fr, relative_stride_length=speed * STRIDE / 0.862, stride_cv=0.0,
+             apex_height_m=0.0, cpg_period_s=period, cpg_gait="walk", survived_s=survived,
+             total_s=12.0, trunk_lean_deg=3.0)
+    return s
+
+
+def test_cost_follows_the_criteria():
+    good = walk_summary()
+    assert not CRITERIA["walk"].failures(good), CRITERIA["walk"].failures(good)
+    c_good = rollout_cost("walk", good, 10.0)
+    # meets every criterion with the margin; only the progress towards the target Froude
+    # number (0.12, above the criteria's 0.08) is left: 1 m/s of about 1.0 m/s
+    assert c_good < 0.5
+    slow = walk_summary(speed=0.4)  # Fr 0.019: below the walk's 0.08
+    assert CRITERIA["walk"].failures(slow)
+    assert rollout_cost("walk", slow, 10.0) > c_good + 3.0
+    # a fall costs more than any upright rollout, and less the later it comes
+    early = walk_summary(fell_at=3.0, survived=3.0)
+    late = walk_summary(fell_at=10.0, survived=10.0)
+    assert rollout_cost("walk", early, 10.0) > rollout_cost("walk", late, 10.0) > \
+        rollout_cost("walk", slow, 10.0)
+    # the body must keep the CPG's rhythm: the same walk against a CPG twice as slow
+    assert rollout_cost("walk", walk_summary(period=2 * STRIDE), 10.0) >= c_good + 0.99
+    # an upright trunk: the same walk bent forward by 30 deg on average
+    bent = dict(good, trunk_lean_deg=30.0)
+    assert rollout_cost("walk", bent, 10.0) == pytest.approx(c_good + 2.0)
+
+
+def test_target_speed_is_above_the_criteria():
+    for g in ("walk", "run"):
+        v = target_speed(g)
+        assert v ** 2 / (9.81 * 0.862) > CRITERIA[g].froude_min
+
+
+def test_tuning_conditions_are_disjoint_from_the_tests():
+    """The tests and the README report the Table 3 state (cpg seed None), CPG seeds 10-19,
+    friction x0.5/0.7/1.3/2.0 from the Table 3 state and pushes of 5 N s at 6 s from it."""
+    from tests.test_physics import CONDITIONS, PERTURBATIONS
+
+    test_seeds = {c.get("seed") for c in CONDITIONS + PERTURBATIONS}
+    assert None in test_seeds and set(range(10, 20)) <= test_seeds
+    conds = tuning_conditions(16)
+    assert len({c["cpg_seed"] for c in conds}) == 16
+    for c in conds:
+        assert c["cpg_seed"] is not None and c["cpg_seed"] >= FIRST_TUNING_SEED
+        assert c["cpg_seed"] not in test_seeds
+
+
+def test_settings_refuse_bad_input():
+    with pytest.raises(InputError, match="unknown gait"):
+        check_gaits("walk,skip")
+    for bad in (dict(algorithm="de"), dict(seconds=1.0), dict(n_conditions=17),
+                dict(sigma=0.0)):
+        with pytest.raises(InputError):
+            TuneSettings(("walk",), **bad)
+    assert check_gaits("all") == tuple(CORNER_OF)
+    assert len(variables(TuneSettings(("jump", "hop"), search="both"))) == 2 * 22 + 5
+    assert len(variables(TuneSettings(("walk", "run", "jump", "hop"), search="shared"))) == 5
+    with pytest.raises(InputError, match="unknown search"):
+        TuneSettings(("walk",), search="everything")
+
+
+class Quadratic(Problem):
+    def __init__(self):
+        super().__init__(n_var=6, n_obj=1, xl=-np.ones(6), xu=2 * np.ones(6))
+
+    def _evaluate(self, X, out, *a, **k):
+        out["F"] = ((X - 0.3) ** 2).sum(axis=1)[:, None]
+
+
+def _cmaes(seed, stop=None, resume=None):
+    if resume is None:
+        alg = CMAES(np.zeros(6), 0.3, 8, seed=seed)
+        alg.setup(Quadratic(), termination=("n_gen", 40), seed=seed)
+    else:
+        alg = pickle.loads(resume)
+    n = 0
+    while alg.has_next():
+        alg.next()
+        n += 1
+        if stop and n == stop:
+            return pickle.dumps(alg)
+    return alg.opt.get("X")[0], alg.opt.get("F")[0, 0]
+
+
+def test_cmaes_resumes_exactly_and_leaves_numpy_alone():
+    x, f = _cmaes(3)
+    assert f < 1e-2  # it converges on a quadratic
+    x2, f2 = _cmaes(3, resume=_cmaes(3, stop=9))
+    assert np.array_equal(x, x2) and f == f2
+    assert not np.array_equal(_cmaes(4)[0], x)
+    np.random.seed(5)
+    a = np.random.rand()
+    np.random.seed(5)
+    _cmaes(3)
+    assert np.random.rand() == a  # NumPy's global generator is untouched
+
+
+SMALL = dict(pop=4, gens=3, seed=5, checkpoint_every=1)
+
+
+def _small_tune(out, stop_after=None, algorithm="cmaes"):
+    s = TuneSettings(("hop",), algorithm=algorithm, seconds=2.0, n_conditions=1)
+    return tune(s, RunSettings(**SMALL), out, SerialRunner(2.0), command="test",
+                stop_after=stop_after)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("algorithm", ["cmaes", "nsga2"])
+def test_small_run_writes_a_gains_file_and_resumes_identically(tmp_path, algorithm):
+    full = _small_tune(tmp_path / "full", algorithm=algorithm)
+    with pytest.raises(KeyboardInterrupt):
+        _small_tune(tmp_path / "cut", stop_after=1, algorithm=algorithm)
+    assert not (tmp_path / "cut" / "gains.json").exists()  # all-or-nothing
+    resumed = _small_tune(tmp_path / "cut", algorithm=algorithm)
+    a = json.loads((tmp_path / "full" / "gains.json").read_text())
+    b = json.loads((tmp_path / "cut" / "gains.json").read_text())
+    assert a["corners"] == b["corners"] and a["shared"] == b["shared"]
+    assert full["entry"]["cost"] == resumed["entry"]["cost"]
+    # the file is a gains file the controller reads; only the hop's corner moved
+    p, prov = read_gains(tmp_path / "full" / "gains.json")
+    assert prov[-1]["command"] == "test" and prov[-1]["seed"] == 5
+    assert prov[-1]["conditions"] == json.loads(json.dumps(tuning_conditions(1)))
+    assert prov[-1]["started_from_sha256"]
+    assert p.alternating == CONTROL.alternating and p.synchronous == CONTROL.synchronous
+    assert p.synchronous_coactive != CONTROL.synchronous_coactive
+    history = (tmp_path / "full" / "tune_history.csv").read_text().splitlines()
+    assert len(history) == 1 + SMALL["gens"]
+
+
+def test_the_controller_loads_one_chain_of_tuning_runs():
+    """The committed gains are the end of a chain that starts at the hand-set root file: each
+    cpgbiped tune run started from the parameters the one before it ended with (SHA-256 of
+    the values), with its command, seed and tuning conditions recorded, and the last one
+    ended with exactly the parameters the controller loads (scripts/tune_gains.sh re-runs
+    the chain)."""
+    from envs.controller_tuning import ROOT_GAINS_FILE, params_sha256
+
+    p, prov = read_gains(GAINS_FILE)
+    assert p == CONTROL
+    root, root_prov = read_gains(ROOT_GAINS_FILE)
+    assert root_prov[0].get("hand_set") and prov[0] == root_prov[0]
+    ends = params_sha256(root)
+    for entry in prov[1:]:
+        assert entry["command"].startswith("cpgbiped tune")
+        assert isinstance(entry["seed"], int) and entry["conditions"] == json.loads(
+            json.dumps(tuning_conditions(entry["settings"]["n_conditions"])))
+        assert entry["started_from_sha256"] == ends
+        ends = entry["result_sha256"]
+    assert ends == params_sha256(p) and len(prov) > 1
