@@ -35,7 +35,8 @@ P_SIZE = N_SHARED + 4 * len(BLENDED)
 IX_SIZE = 25
 
 # Controller state layout (pairs are left, right).
-S_LAST_GROUND, S_WAS_GROUND, S_PUSHED, S_SWUNG, S_MODE = 0, 2, 4, 6, 8
+# S_LAST_GROUND: the last time (s) each foot carried CONTACT_N; slots 2-3 are unused.
+S_LAST_GROUND, S_PUSHED, S_SWUNG, S_MODE = 0, 4, 6, 8
 # Running averages behind the CPG features: sigma (left-right synchrony of the extensors) and
 # kappa (flexor-extensor co-activation).
 S_LAST_T, S_C_LR, S_V_L, S_V_R, S_SYNC, S_C_FE, S_V_F, S_V_E, S_COACT = 10, 11, 12, 13, 14, 15, 16, 17, 18
@@ -65,7 +66,6 @@ SIGMA_LIFT = 0.4  # a leg lifts on its own only in a rhythm whose legs alternate
 def new_state() -> np.ndarray:
     s = np.zeros(S_SIZE)
     s[S_LAST_GROUND:S_LAST_GROUND + 2] = 0.0  # the body starts standing on both feet
-    s[S_WAS_GROUND:S_WAS_GROUND + 2] = 1.0
     s[S_LAST_T] = -1.0
     # The running averages start from a neutral prior, as if the cells had burst with a
     # correlation of one half: sigma = kappa = 0.5 when the body starts. The controller has
@@ -176,15 +176,15 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
     # "pushed": the leg took off during its extensor burst (it stood on the ground in this
     # burst and is now off it while the other leg is not still pushing on the ground); a
     # landing in the same burst is absorbed, not pushed again. Cleared when the burst ends.
-    # "swing": the leg was lifted by its swing drive (it stood, the drive came on, and the
-    # other leg stood on the ground with its stance command and without a swing drive of its
-    # own, in a rhythm whose legs alternate (sigma < SIGMA_LIFT): a leg never lifts away the only
-    # support, and a synchronous rhythm - a jump's flexor burst, or a walk network's
-    # transient through in-phase bursts - lifts no leg on its own: both legs leave the
-    # ground together, by their push); it swings until its foot lands again,
-    # after having left the ground, when the
-    # drive is over, or x_clear ahead of the hip (where the swing stops tucking; a scuff
-    # behind that in mid-swing is not a landing), or with the other foot off the ground.
+    # "swing": the leg was lifted by its swing drive. It lifts once per drive, only from the
+    # ground, and only while the other leg stands with its stance command and no swing drive of
+    # its own, in a rhythm whose legs alternate (sigma < SIGMA_LIFT): a leg never lifts away
+    # the only support, and a synchronous rhythm (a jump's flexor burst, or a walk network's
+    # transient through in-phase bursts) lifts no leg on its own; both legs leave the ground
+    # together, by their push. It swings until its foot lands after having left the ground,
+    # and the landing counts when the drive is over, or the foot is x_clear ahead of the hip
+    # (where the swing stops tucking; a scuff behind that in mid-swing is not a landing), or
+    # the other foot is off the ground.
     stance_cmd = np.empty(2, dtype=np.bool_)
     for i in range(2):
         stance_cmd[i] = e[i] >= e_on
@@ -214,8 +214,6 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
                 S[S_SWUNG + i] = 0.0
         if g[i] < 0.5:  # one lift per swing drive
             S[S_SWING_DONE + i] = 0.0
-    for i in range(2):
-        S[S_WAS_GROUND + i] = 1.0 if ground[i] else 0.0
 
     # Modes: a swinging leg is in the air (or lifting, its foot still down); any other leg is
     # a support leg on the ground and in the air otherwise (it prepares to land).

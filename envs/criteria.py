@@ -155,7 +155,7 @@ class Criteria:
         the other gaits' summaries in ``others`` (gait -> summary) where given."""
         out = []
         if s["fell"]:
-            out.append(f"fell at {s['fell_at_s']} s")
+            out.append(f"fell at {s['fell_at_s']:.2f} s")
         if s["physical_gait"] != self.gait:
             out.append(f"physical gait {s['physical_gait']}")
         if s.get("cpg_gait", self.gait) != self.gait:
