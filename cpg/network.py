@@ -252,12 +252,15 @@ class HopfPreset:
 
 
 # The primary gaits of the Hopf network. The lags are those of the gait table (every cell in
-# the phase the Morris-Lecar preset of that gait reaches); beta (the fraction of the cycle in
-# the "stance" half, y > 0, i.e. the burst) follows the Morris-Lecar presets' burst fractions
-# (about 0.3 for walk and run, 0.4 for jump and hop), and the cycle time is the Morris-Lecar
-# preset's period (Table 2 weights, `cpgbiped reproduce`) at ML_UNITS_PER_S, so that the two
-# networks ask the body for the same cadences: 13.113, 8.868, 11.985 and 7.918 model units,
-# i.e. 0.672, 0.455, 0.615 and 0.406 s.
+# the phase the Morris-Lecar preset of that gait reaches); beta is the fraction of the cycle in
+# the "stance" half, y > 0 (the burst). The cycle time is the Morris-Lecar preset's period
+# (Table 2 weights, `cpgbiped reproduce`) at ML_UNITS_PER_S, so that the two networks ask the
+# body for the same cadences: 13.113, 8.868, 11.985 and 7.918 model units, i.e. 1.066, 0.721,
+# 0.974 and 0.644 s. The period formula below is the large-a limit; it holds within 5% for
+# beta >= 0.35 (at beta 0.3 the walk's measured period is 8% shorter), which sets the betas
+# even though the cells' activations then exceed one half (the controller's stance threshold)
+# for longer than the Morris-Lecar cells': 0.42, 0.40, 0.45, 0.40 of the cycle against 0.30,
+# 0.35, 0.38, 0.42 (walk, run, jump, hop; measured from the presets' states over 20 cycles).
 ML_TABLE2_PERIODS = {"walk": 13.113, "run": 8.868, "jump": 11.985, "hop": 7.918}
 
 
