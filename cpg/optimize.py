@@ -327,8 +327,10 @@ def load_checkpoint(path: Path, meta: dict, algorithm_type=None):
     if not isinstance(algorithm, algorithm_type) or pop is None \
             or np.asarray(pop.get("X")).ndim != 2 \
             or np.asarray(pop.get("X")).shape[1] != meta["n_var"]:
-        raise InputError(f"unreadable checkpoint {name!r}: it does not hold a "
-                         f"{algorithm_type.__name__} run of this problem")
+        label = {"NSGA2": "an NSGA-II", "CMAES": "a CMA-ES"}.get(
+            algorithm_type.__name__, f"a {algorithm_type.__name__}")
+        raise InputError(f"unreadable checkpoint {name!r}: it does not hold {label} run "
+                         f"of this problem")
     return algorithm
 
 
