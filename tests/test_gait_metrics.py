@@ -18,21 +18,24 @@ def series(period, duty, lag, speed=1.0):
     return c, speed * T
 
 
-def ankle_wave(period, amplitude_deg):
-    """Ankle angles (T, 2) that swing by ``amplitude_deg`` peak to peak once per stride."""
-    a = 0.5 * np.radians(amplitude_deg) * np.sin(2 * np.pi * T / period)
-    return np.stack([a, a], axis=1)
+def ankle_wave(period, duty, amplitude_deg):
+    """Ankle angles (T, 2) of feet in phase: from -a to +a linearly over each stance (the first
+    ``duty`` of the stride) and back in the air, so that every stance spans ``amplitude_deg``."""
+    a, ph = 0.5 * np.radians(amplitude_deg), (T / period) % 1.0
+    q = np.where(ph < duty, -a + 2 * a * ph / duty, a - 2 * a * (ph - duty) / (1 - duty))
+    return np.stack([q, q], axis=1)
 
 
 @pytest.mark.parametrize("period,duty,lag,ankle_deg,want", [
     (1.0, 0.65, 0.5, 30.0, "walk"), (0.7, 0.35, 0.5, 30.0, "run"),
     (0.8, 0.55, 0.0, 40.0, "jump"), (0.6, 0.55, 0.0, 6.0, "hop"),
-    (0.6, 0.3, 0.0, 40.0, "jump"), (0.8, 0.7, 0.0, 6.0, "hop")])
+    (0.6, 0.3, 0.0, 40.0, "jump"), (0.8, 0.7, 0.0, 6.0, "hop"),
+    (0.8, 0.55, 0.0, 32.0, "jump"), (0.8, 0.55, 0.0, 28.0, "hop")])  # either side of 30 deg
 def test_known_gaits(period, duty, lag, ankle_deg, want):
     """The two-legged gaits are told apart by the ankle, never by the duty factor: a short-
     contact bounce whose ankle rotates is a jump, a long-contact one with a stiff ankle a hop."""
     c, x = series(period, duty, lag)
-    m = gm.measure(T, c, x, settle_s=2.0, ankle=ankle_wave(period, ankle_deg))
+    m = gm.measure(T, c, x, settle_s=2.0, ankle=ankle_wave(period, duty, ankle_deg))
     assert m.stride_period_s == pytest.approx(period, abs=2 * DT)
     for leg in ("left", "right"):
         assert m.duty_factor[leg] == pytest.approx(duty, abs=0.01)
@@ -170,3 +173,14 @@ def test_froude_stride_length_cot_and_work_shares_by_construction():
                         np.array(["ankle", "hip", "knee"]), np.array([0, 0, 1]), still, L, mass,
                         settle_s=2.0)
     assert b.cost_of_transport is None and b.work_per_stride_J == pytest.approx(50 * 0.65, rel=0.02)
+
+
+def test_readme_criteria_table_is_the_criteria_data():
+    """The README's criteria table is printed from envs/criteria.py (one place for the data
+    the classifier, the tests, the tuner and the README read)."""
+    from pathlib import Path
+
+    from envs.criteria import criteria_markdown
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    assert criteria_markdown() in readme

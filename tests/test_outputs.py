@@ -89,7 +89,7 @@ def test_render_video(tmp_path):
     assert video.shape[0] == 20 and video.shape[1:3] == (120, 160)
     assert video.std() > 5  # not blank
     assert np.abs(video[-1].astype(int) - video[0].astype(int)).mean() > 1  # changes over time
-    for f in ("walk_gait.png", "walk_cycle.png", "walk_signals.png"):
+    for f in ("walk_chrono.png", "walk_gait.png", "walk_cycle.png", "walk_signals.png"):
         assert (tmp_path / f).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
@@ -194,11 +194,12 @@ def test_demo_produces_everything(tmp_path):
     r = cli("demo", "--out", str(out), "--seconds", "4", "--video-seconds", "1", "--quiet")
     assert r.returncode == 0, r.stderr
     for g in ("walk", "run", "jump", "hop"):
-        for suffix in (".mp4", "_gait.png", "_cycle.png", "_signals.png", "_frame.png"):
+        for suffix in (".mp4", "_chrono.png", "_gait.png", "_cycle.png", "_signals.png",
+                       "_frame.png"):
             assert (out / f"{g}{suffix}").stat().st_size > 0
     assert (out / "demo.rrd").stat().st_size > 0
     readme = (out / "README.md").read_text()
-    assert "walk_frame.png" in readme and "verdict" in readme
+    assert "walk_frame.png" in readme and "walk_chrono.png" in readme and "verdict" in readme
     summary = json.loads((out / "summary.json").read_text())
     assert set(summary["physics"]) == {"walk", "run", "jump", "hop"}
 
