@@ -18,6 +18,7 @@ foot has too few touchdowns.
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -148,7 +149,9 @@ def chronophotograph(rec, path: str | Path, metrics=None, title: str = "", strid
                                    "time, as on a moving plate" if spread else ""), fontsize=8)
     ax.set_yticks([0, 0.5, 1.0, 1.5])
     ax.tick_params(labelsize=7)
-    ax.set_title(title, fontsize=10, loc="left")
+    # wrapped to the axes (about 7 characters per inch of figure at 10 pt), so that the
+    # narrow picture of an in-place gait does not cut its numbers off
+    ax.set_title(textwrap.fill(title, max(40, int(7 * width))), fontsize=10, loc="left")
     # the footfall strip of the same window
     for row, (side, leg, color) in enumerate(legs):
         c = contact[:, leg]
