@@ -14,9 +14,9 @@ from cpg.errors import InputError
 from cpg.optimize import RunSettings
 from envs import gait_metrics as gm
 from envs.controller import CONTROL, GAINS_FILE, read_gains
-from envs.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, ROOT_GAINS_FILE,
-                                    TuneSettings, check_gaits, rollout_cost, target_speed, tune, tuning_conditions,
-                                    variables)
+from envs.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, ROOT_GAINS_FILE, TuneSettings,
+                                    check_gaits, rollout_cost, target_speed, tune,
+                                    tuning_conditions, variables)
 from envs.criteria import CRITERIA
 from envs.trials import SerialRunner
 
