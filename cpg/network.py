@@ -114,6 +114,11 @@ class Network:
         """The parameters as plain numbers (for reports and JSON)."""
         raise NotImplementedError
 
+    def loop_spec(self) -> dict:
+        """What :mod:`cpg.feedback` needs to step the network in a closed loop: ``code``, the
+        parameters ``P`` as a flat array, the activation map's ``act_centre``/``act_width``."""
+        raise InputError(f"the {self.kind} network cannot be stepped with feedback")
+
     # -- shared ------------------------------------------------------------------------------
     def with_state(self, y0) -> "Network":
         """The same network from another initial state."""
@@ -235,6 +240,12 @@ class MorrisLecarNetwork(Network):
     def activation(self, v):
         return _sigmoid((np.asarray(v, dtype=float) - ML_V_HALF) / ML_V_WIDTH)
 
+    def loop_spec(self):
+        from .feedback import KIND_ML
+
+        return {"code": KIND_ML, "P": np.concatenate([[self.i_app, self.phi], self.W.ravel()]),
+                "act_centre": ML_V_HALF, "act_width": ML_V_WIDTH}
+
     def params(self):
         return {"i_app": self.i_app, "phi": self.phi,
                 "weights_directed": dict(zip(ml.DIRECTED_NAMES,
@@ -305,6 +316,16 @@ class HopfNetwork(Network):
     def activation(self, v):
         return _sigmoid(np.asarray(v, dtype=float) / HOPF_WIDTH)
 
+    def loop_spec(self):
+        from .feedback import KIND_HOPF
+
+        p, th = self.p, hopf_mod.theta_matrix(self.lags)
+        return {"code": KIND_HOPF,
+                "P": np.concatenate([[p.mu, p.alpha, p.omega_st, p.omega_sw, p.a, p.k,
+                                      float(p.normalised)], np.cos(th).ravel(),
+                                     np.sin(th).ravel()]),
+                "act_centre": 0.0, "act_width": HOPF_WIDTH}
+
     def params(self):
         return {"lags": self.lags.tolist(), "beta": self.p.beta, "omega_sw": self.p.omega_sw,
                 "mu": self.p.mu, "alpha": self.p.alpha, "a": self.p.a, "k": self.p.k,
@@ -344,6 +365,16 @@ class MatsuokaNetwork(Network):
     def activation(self, v):
         v = np.asarray(v, dtype=float)
         return _sigmoid((v - MATSUOKA_HALF * MATSUOKA_PEAK) / (0.08 * MATSUOKA_PEAK))
+
+    def loop_spec(self):
+        from .feedback import KIND_MATSUOKA
+
+        p = self.p
+        return {"code": KIND_MATSUOKA,
+                "P": np.concatenate([[p.tau, p.T, p.beta, p.r, p.L, p.k_f, p.k_i],
+                                     mt.W_PRINTED.ravel()]),
+                "act_centre": MATSUOKA_HALF * MATSUOKA_PEAK, "act_width": 0.08 * MATSUOKA_PEAK,
+                "L": p.L, "seed": self.seed}
 
     def params(self):
         return {"tau": self.p.tau, "T": self.p.T, "beta": self.p.beta, "r": self.p.r,

@@ -17,6 +17,11 @@ import math
 import numpy as np
 from numba import njit
 
+from cpg.feedback import LOAD_CONTACT
+from cpg.feedback import advance as fb_advance
+from cpg.feedback import inputs as fb_inputs
+from cpg.feedback import outputs as fb_outputs
+
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in
 # CORNER order: (sigma, kappa) = (0, 0), (0, 1), (1, 0), (1, 1).
@@ -50,10 +55,11 @@ MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
 # Recording columns, one row per control tick.
 # R_V: CPG outputs; R_DRIVE: their activations (the CPG's drive); R_ACT: the ankle muscles'
 # activation state (MjData.act); R_CTRL: the 8 controls sent; R_POWER: each actuator's
-# mechanical power (actuator force x actuator velocity, W; the actuator order of the model).
+# mechanical power (actuator force x actuator velocity, W; the actuator order of the model);
+# R_FB: the feedback term each cell receives (cpg.feedback.inputs; zero open loop).
 (R_T, R_CONTACT, R_FORCE, R_V, R_DRIVE, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX, R_COMZ,
- R_MODE, R_CTRL, R_POWER) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37)
-R_SIZE = 45
+ R_MODE, R_CTRL, R_POWER, R_FB) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37, 45)
+R_SIZE = 49
 
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (biped.xml)
@@ -101,11 +107,16 @@ def sample(sched, dt_s, t_s, out):
 @njit(cache=True)
 def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_out, a_out):
     """Write the 8 controls for time t_s (s) into u, the CPG outputs into v_out and the
-    activations into a_out."""
-    ankle_gain, e_on, w_flex, w_cross, contact_hold = P[0], P[1], P[2], P[3], P[4]
+    activations into a_out (open loop: sampled from the schedule)."""
     sample(sched_v, dt_s, t_s, v_out)
     sample(sched_a, dt_s, t_s, a_out)
-    a = a_out
+    control_from(t_s, a_out, P, S, qpos, qvel, sens, xpos, ix, u)
+
+
+@njit(cache=True)
+def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
+    """Write the 8 controls for time t_s (s) into u, from the CPG's activations a (4,)."""
+    ankle_gain, e_on, w_flex, w_cross, contact_hold = P[0], P[1], P[2], P[3], P[4]
     # Per leg i (0 left, 1 right): flexor f = a[i], extensor e = a[2 + i].
     e = np.empty(2)
     f = np.empty(2)
@@ -283,7 +294,7 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
 
 
 @njit(cache=True)
-def record(k, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, S, rec, fall_height,
+def record(k, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, fb, S, rec, fall_height,
            fall_pitch):
     """Write row k of the recording; return 0 (fine), 1 (fallen) or 2 (non-finite state)."""
     for j in range(qpos.shape[0]):
@@ -300,6 +311,7 @@ def record(k, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, S, rec, fa
         r[R_V + c] = v[c]
         r[R_DRIVE + c] = a[c]
         r[R_ACT + c] = act[c]
+        r[R_FB + c] = fb[c]
     for c in range(8):
         r[R_CTRL + c] = ctrl[c]
         r[R_POWER + c] = afrc[c] * avel[c]
@@ -340,9 +352,63 @@ def tick(k, t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, act, ctrl
     into ``ctrl``. Returns the status of row k - 1 (:func:`record`; 0 when k = 0)."""
     status = 0
     if k > 0:
-        status = record(k - 1, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, S, rec,
-                        fall_height, fall_pitch)
+        status = record(k - 1, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, NO_FB, S,
+                        rec, fall_height, fall_pitch)
         if status == 2:
             return status
     control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, ctrl, v, a)
+    return status
+
+
+NO_FB = np.zeros(4)  # the feedback row of an open-loop rollout
+
+
+@njit(cache=True)
+def body_sensors(qpos, sens, ix, weight_n, out):
+    """The sensors the CPG's feedback reads (cpg.feedback): out = (n_L, n_R, q_L, q_R), the
+    feet's normal loads in body weights (weight_n newtons) and the contact-gated thigh angles
+    (rad from the vertical, > 0 forward)."""
+    for i in range(2):
+        n = abs(sens[ix[IX_FORCE + i]]) / weight_n
+        out[i] = n
+        gate = 1.0 if n > LOAD_CONTACT else 0.0
+        out[2 + i] = gate * (qpos[ix[IX_HIP_Q + i]] + qpos[ix[IX_ROOTY_Q]])
+
+
+@njit(cache=True)
+def step_closed(advance_first, code, NP, y, K, n_sub, h, noise, step0, act_c, act_w, weight_n,
+                sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix, ctrl, v, a):
+    """The closed-loop controller at one tick (cpg.feedback): when ``advance_first``, advance
+    the network over the last tick with the sensors held since then (``sensors``; ``step0``
+    is the tick's first network step, for the Matsuoka noise); then read this tick's sensors
+    into ``sensors``, their feedback terms into ``fb``, the CPG's outputs into v and a, and the
+    controls into ``ctrl``. Returns False when the network's state left its range."""
+    if advance_first:
+        if not fb_advance(code, NP, y, K, sensors, n_sub, h, noise, step0, scratch[5, :4],
+                          scratch):
+            return False
+    body_sensors(qpos, sens, ix, weight_n, sensors)
+    fb_inputs(code, K, y, sensors, fb)
+    fb_outputs(code, y, act_c, act_w, v, a)
+    control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, ctrl)
+    return True
+
+
+@njit(cache=True)
+def tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w, weight_n, sensors, fb,
+                scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
+                fall_height, fall_pitch):
+    """One closed-loop control tick of a rollout: record row k - 1 (with the CPG outputs and
+    feedback terms of tick k - 1), then :func:`step_closed`. Returns the status of row k - 1,
+    or 2 when the network's state left its range."""
+    status = 0
+    if k > 0:
+        status = record(k - 1, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, fb, S,
+                        rec, fall_height, fall_pitch)
+        if status == 2:
+            return status
+    if not step_closed(k > 0, code, NP, y, K, n_sub, h, noise, (k - 1) * n_sub, act_c, act_w,
+                       weight_n, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix,
+                       ctrl, v, a):
+        return 2
     return status

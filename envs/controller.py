@@ -297,16 +297,24 @@ BODY_FLOOR_SENSORS = ("torso", "left_thigh", "left_shank", "right_thigh", "right
 
 
 class CPGController:
-    """Maps the CPG schedule and the body state to the 8 actuator controls.
+    """Maps the CPG (open loop: its schedule; closed loop: the network stepped here, reading
+    the body's sensors, :mod:`cpg.feedback`) and the body state to the 8 actuator controls.
 
     A thin holder of the compiled kernel's inputs (:func:`envs.control_kernel.control`): the
     MjData views are taken once, so a call costs one kernel dispatch. model, data: the raw
     ``mujoco.MjModel`` / ``mujoco.MjData`` (a dm_control Physics' ``model.ptr``, ``data.ptr``).
+    Closed loop (``loop`` given, ``schedule`` None), every call is one control tick of
+    ``loop``'s tick length: the network advances by one tick before the controls are formed.
     """
 
-    def __init__(self, model, data, schedule: CPGSchedule, params: ControlParams = CONTROL):
+    def __init__(self, model, data, schedule: CPGSchedule | None, params: ControlParams = CONTROL,
+                 loop=None):
+        if (schedule is None) == (loop is None):
+            raise InputError("a controller needs either a CPG schedule (open loop) or a network "
+                             "to step (closed loop)")
         self.p = params
         self.sched = schedule
+        self.loop = loop
         self.P = params_array(params)
         self.S = kernel.new_state()
         self.ix = kernel_index(model)
@@ -315,15 +323,37 @@ class CPGController:
         self.u = np.zeros(8)
         self.last_v = np.zeros(4)
         self.last_a = np.zeros(4)
+        # closed loop: the sensors held over a tick, the feedback terms, work space
+        self.weight_n = float(model.body_subtreemass[0] * np.linalg.norm(model.opt.gravity))
+        self.sensors = np.zeros(4)
+        self.fb = np.zeros(4)
+        self.scratch = np.zeros((6, 24))
+        self.ticks = 0
 
     @property
     def modes(self) -> np.ndarray:
         """(2,) leg modes (kernel.MODE_SUPPORT, MODE_LIFT, MODE_AIR) of the last tick."""
         return self.S[kernel.S_MODE:kernel.S_MODE + 2].copy()
 
+    @property
+    def feedback(self) -> np.ndarray:
+        """(4,) the feedback term each cell received at the last tick (zero open loop)."""
+        return self.fb.copy()
+
     def __call__(self, t_s: float) -> np.ndarray:
         """The 8 controls at time t_s (s): LF, RF, LE, RE muscles, then hip and knee torques."""
         qpos, qvel, sens, xpos = self.views
-        kernel.control(t_s, self.sched.v, self.sched.a, self.sched.dt_s, self.P, self.S, qpos,
-                       qvel, sens, xpos, self.ix, self.u, self.last_v, self.last_a)
+        if self.loop is None:
+            kernel.control(t_s, self.sched.v, self.sched.a, self.sched.dt_s, self.P, self.S,
+                           qpos, qvel, sens, xpos, self.ix, self.u, self.last_v, self.last_a)
+            return self.u
+        L = self.loop
+        ok = kernel.step_closed(self.ticks > 0, L.code, L.P, L.y, L.gain, L.n_sub, L.h, L.noise,
+                                (self.ticks - 1) * L.n_sub, L.act_centre, L.act_width,
+                                self.weight_n, self.sensors, self.fb, self.scratch, t_s, self.P,
+                                self.S, qpos, qvel, sens, xpos, self.ix, self.u, self.last_v,
+                                self.last_a)
+        self.ticks += 1
+        if not ok:
+            raise InputError("the network's state left its range under feedback: lower the gain")
         return self.u

@@ -12,6 +12,7 @@ import mujoco
 import numpy as np
 
 from cpg.errors import InputError
+from cpg.feedback import check_gain, loop_network
 from cpg.integrate import Schedule
 from cpg.network import Network
 from models import BIPED_SCENE
@@ -52,6 +53,8 @@ class Recording:
     qpos: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (T, nq)
     body_pose: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 7)))  # (T, nbody, 7)
     xml_path: str = str(BIPED_SCENE)  # the model the rollout ran (renderers, rerun)
+    feedback: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # (T, 4) per cell
+    feedback_gain: float = 0.0  # K of cpg.feedback (0: open loop)
 
 
 def check_seconds(seconds: float, name: str = "seconds") -> float:
@@ -80,7 +83,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
             friction_scale: float = 1.0, push: tuple[float, float] | None = None,
             stop_on_fall: bool = True, ankle_drive: bool = True,
             to: Network | None = None, change: Schedule | None = None,
-            xml_path: str | Path = BIPED_SCENE, poses: bool = True) -> Recording:
+            xml_path: str | Path = BIPED_SCENE, poses: bool = True,
+            feedback: float = 0.0) -> Recording:
     """Run the CPG-driven biped for ``seconds`` of simulated time.
 
     Every tick records the joint positions and every body's world pose (forward kinematics of
@@ -89,19 +93,28 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     CPG's ankle drive (the reflexes stay). to, change: the network's parameters move towards
     ``to``'s along ``change`` (knot times in seconds). poses=False skips the joint positions
     and body poses (``qpos``, ``body_pose`` stay empty): searches that only need the metrics
-    save the forward kinematics of every tick.
+    save the forward kinematics of every tick. feedback: the gain K of the body's feedback
+    into the CPG (:mod:`cpg.feedback`); 0 (default) integrates the network ahead, open loop,
+    as the paper does; K > 0 steps it tick by tick with the sensors.
     """
     seconds = check_seconds(seconds)
     push = check_push(push, seconds)
+    K = check_gain(network.kind, feedback)
+    if K > 0 and (to is not None or change is not None):
+        raise InputError("feedback into a network whose parameters change in mid-run is not "
+                         "supported: use one or the other")
     if not ankle_drive:
         params = without_ankle_drive(params)
     m = load_model(xml_path)
     if friction_scale != 1.0:
         scale_friction(m, friction_scale)
     d = mujoco.MjData(m)
-    sched = cpg_schedule(network, seconds, to=to, change=change)
-    ctrl = CPGController(m, d, sched, params)
     dt = m.opt.timestep
+    if K > 0:
+        ctrl = CPGController(m, d, None, params,
+                             loop=loop_network(network, K, dt * CONTROL_EVERY, seconds))
+    else:
+        ctrl = CPGController(m, d, cpg_schedule(network, seconds, to=to, change=change), params)
     n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))
     rec = np.zeros((n_ticks, kernel.R_SIZE))
     qpos_rec = np.zeros((n_ticks if poses else 0, m.nq))
@@ -118,18 +131,31 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     ix, v, a, S = ctrl.ix, ctrl.last_v, ctrl.last_a, ctrl.S
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
     push_tick = None if push is None else int(round(push[0] / (dt * CONTROL_EVERY)))
-    sv, sa, sdt, P, qvel = ctrl.sched.v, ctrl.sched.a, ctrl.sched.dt_s, ctrl.P, d.qvel
+    P, qvel = ctrl.P, d.qvel
+    if K > 0:
+        L = ctrl.loop
+        loop_args = (L.code, L.P, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
+                     ctrl.weight_n, ctrl.sensors, ctrl.fb, ctrl.scratch)
+
+        def tick(k):
+            return kernel.tick_closed(k, d.time, *loop_args, P, S, qpos, qvel, sens, xpos, act,
+                                      ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
+    else:
+        sv, sa, sdt = ctrl.sched.v, ctrl.sched.a, ctrl.sched.dt_s
+
+        def tick(k):
+            return kernel.tick(k, d.time, sv, sa, sdt, P, S, qpos, qvel, sens, xpos, act,
+                               ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
     if not poses:  # the whole loop compiled (envs.step_loop): the same rows, bit for bit
         n, fell, unstable = _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec,
                                            stop_on_fall)
-        return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path)
+        return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path, K)
     try:
         # Tick k records row k - 1 (the state after the last steps) and sets the controls of
         # tick k, in one compiled call (kernel.tick); the loop runs one extra tick for the
         # last row.
         for k in range(n_ticks + 1):
-            status = kernel.tick(k, d.time, sv, sa, sdt, P, S, qpos, qvel, sens, xpos, act,
-                                 ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
+            status = tick(k)
             if k > 0:
                 if status == 2 or bad_qacc.number:
                     unstable = f"physics became unstable at t={d.time:.3f} s"
@@ -152,7 +178,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
                 d.xfrc_applied[torso_id, 0] = 0.0
     except mujoco.FatalError as e:
         raise InputError(f"physics became unstable: {e}") from None
-    return _recording(rec[:n], dt, fell, unstable, qpos_rec[:n], pose_rec[:n], xml_path)
+    return _recording(rec[:n], dt, fell, unstable, qpos_rec[:n], pose_rec[:n], xml_path, K)
 
 
 COMPILED_CHUNK = 250  # ticks (1 s) between two looks at MuJoCo's warnings
@@ -160,7 +186,7 @@ COMPILED_CHUNK = 250  # ticks (1 s) between two looks at MuJoCo's warnings
 
 def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_fall):
     """The tick loop of :func:`rollout` in compiled chunks; (rows, fell_at, unstable)."""
-    from .step_loop import run_ticks
+    from .step_loop import run_ticks, run_ticks_closed
 
     dt = m.opt.timestep
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
@@ -172,9 +198,16 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_
     sched = ctrl.sched
     while k <= n_ticks:
         k_end = min(k + COMPILED_CHUNK, n_ticks + 1)
-        k_next, status = run_ticks(m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY,
-                                   d.time, dt, sched.v, sched.a, sched.dt_s, ctrl.P, ctrl.S,
-                                   *args)
+        if ctrl.loop is None:
+            k_next, status = run_ticks(m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY,
+                                       d.time, dt, sched.v, sched.a, sched.dt_s, ctrl.P, ctrl.S,
+                                       *args)
+        else:
+            L = ctrl.loop
+            k_next, status = run_ticks_closed(
+                m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY, d.time, dt, L.code,
+                L.P, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
+                ctrl.weight_n, ctrl.sensors, ctrl.fb, ctrl.scratch, ctrl.P, ctrl.S, *args)
         if bad_qacc.number:  # somewhere in this chunk: keep the rows recorded before it
             return max(k - 1, 0), fell, f"physics became unstable at t={d.time:.3f} s"
         if status == 2:  # row k_next - 2 is not finite
@@ -189,12 +222,12 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_
     return n, fell, None
 
 
-def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path) -> Recording:
+def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path,
+               gain: float = 0.0) -> Recording:
     K = kernel
     col = lambda a, n=1: r[:, a:a + n].copy() if n > 1 else r[:, a].copy()  # noqa: E731
     return Recording(col(K.R_T), col(K.R_CONTACT, 2) > 0.5, col(K.R_FORCE, 2), col(K.R_V, 4),
                      col(K.R_DRIVE, 4), col(K.R_ACT, 4), col(K.R_JOINTS, 6), col(K.R_HEIGHT),
                      col(K.R_PITCH), col(K.R_COMX), col(K.R_COMZ), col(K.R_MODE, 2),
                      col(K.R_CTRL, 8), col(K.R_POWER, 8), dt * CONTROL_EVERY, dt, fell, unstable,
-                     qpos, pose,
-                     str(xml_path))
+                     qpos, pose, str(xml_path), col(K.R_FB, 4), gain)

@@ -103,7 +103,8 @@ def test_fall_sensors_see_a_body_on_the_floor():
         rec = np.zeros((1, K.R_SIZE))
         verdicts.append(K.record(0, 0.0, d.qpos, d.sensordata, d.xpos, d.act, d.ctrl,
                                  d.actuator_force, d.actuator_velocity, ix, np.zeros(4),
-                                 np.zeros(4), K.new_state(), rec, -np.inf, np.inf))
+                                 np.zeros(4), np.zeros(4), K.new_state(), rec, -np.inf,
+                                 np.inf))
     assert verdicts == [0, 1]
 
 

@@ -1,0 +1,298 @@
+"""Sensory feedback into the CPG: the network stepped tick by tick with inputs from the body.
+
+Open loop (K = 0, the paper's setting) the network is integrated ahead and the body only
+follows it. Closed loop (K > 0) the network's state advances one control tick at a time inside
+the compiled physics loop, and the body's sensors enter its equations. This module holds the
+equations and their only implementation; it never imports MuJoCo: the controller
+(:mod:`envs.control_kernel`) measures the sensors and hands them over as plain numbers.
+
+Sensors, per leg l (0 left, 1 right), measured at every control tick:
+    n_l = F_l / (M g)       the foot's normal ground load in body weights (0 in the air;
+                            about 1/2 per leg standing still, 1 in single support, 2-3 at a
+                            landing)
+    q_l = c_l theta_l       the contact-gated thigh angle: theta_l the thigh's angle from the
+                            vertical in the world (rad, > 0 forward), c_l = 1 while the foot
+                            carries load (n_l > 0.05), else 0.
+Cells in the order LF, RF, LE, RE (flexor and extensor of the left and right ankle); for leg
+l its flexor is cell l and its extensor cell 2 + l. One gain K >= 0 scales every pathway.
+
+Morris-Lecar (load into the extensor's voltage equation, an input current in model units):
+    dv_{2+l}/dt += K (n_l - 1/2)
+  A loaded leg's extensor is depolarised and an unloaded one's hyperpolarised (load feedback
+  from the leg's extensors, Duysens & Pearson): stance lasts while the leg carries the body, a
+  landing excites the extensor. The term is zero for a leg carrying half the body weight, so
+  standing still (both feet, 1/2 each) leaves the network's rhythm as the paper's. The
+  flexors receive nothing directly: their coupling to the extensors (w_b, w_c) carries the
+  input on, whichever sign the preset gives it. Choice measured, not assumed: the variant
+  that also drives each flexor with -K (n_l - 1/2) is in ``scripts/feedback_choice.py``'s
+  output (README, feedback section).
+Hopf (Tegotae, Owaki & Ishiguro 2013/2017: each extensor oscillator's phase is pushed by its
+leg's load). With the phase theta_i = atan2(y_i, x_i) (the burst, y > 0, is theta in (0, pi)):
+    dtheta_{2+l}/dt += K n_l cos(theta_{2+l})
+  i.e. in the oscillator's own coordinates, with r = sqrt(x^2 + y^2),
+    dx += -K n_l (x / r) y,    dy += K n_l (x / r) x.
+  A loaded leg slows in the second half of its burst (cos < 0) and is held there until it is
+  unloaded; the form of Owaki's dphi/dt = omega - sigma N cos(phi) with the burst shifted by pi
+  (his stance is phi in (pi, 2 pi)). K in rad/s per body weight.
+Matsuoka (Taga 1991: contact-gated joint angles into the neurons). Each ankle flexor neuron
+of leg l receives the gated angle of its thigh behind the vertical, the extensor its negative:
+    (tau / k_f) dx_F/dt += K r (-q_l / THETA_REF),   (tau / k_f) dx_E/dt += -K r (-q_l / THETA_REF)
+  A stance leg carried behind the hip excites its flexor (it is time to swing) and releases
+  its extensor; a leg placed ahead does the reverse (Taga's global entrainment). r is the tonic
+  input, so K is a fraction of it; THETA_REF = 0.3 rad.
+
+Integration: one control tick (``tick_s`` seconds) is ``n_sub`` classic RK4 steps of the
+network's own equations with the inputs held over the tick. The inputs are those computed at
+the previous tick (a sensory delay of one control period, 4 ms); the first tick starts from the
+network's initial state. Morris-Lecar: 3 steps of 0.0164 model units per 4 ms tick (below its
+open-loop step, 0.02); Hopf and Matsuoka: 4 steps of 1 ms, the open-loop step, with the
+Matsuoka noise drawn from the same seeded sequence as open loop. With K = 0 the stepped network
+reproduces the open-loop outputs (tested) - but a rollout with K = 0 takes the open-loop path,
+so that it is today's rollout bit for bit.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .errors import InputError
+from .hopf import _rhs4 as _hopf_rhs
+from .integrate import _ml_f
+
+KIND_ML, KIND_HOPF, KIND_MATSUOKA = 0, 1, 2
+LOAD_CONTACT = 0.05  # body weights: a foot carrying more is on the ground (gate c_l)
+THETA_REF = 0.3  # rad: Taga's thigh-angle scale for the Matsuoka pathway
+# The recommended gain of each network (``--feedback`` without a value); chosen by measurement
+# (scripts/feedback_choice.py, README feedback section); units as in the equations above.
+RECOMMENDED = {"ml": 0.05, "hopf": 2.0, "matsuoka": 0.3}
+MAX_GAIN = {"ml": 1.0, "hopf": 50.0, "matsuoka": 5.0}  # beyond these the network is swamped
+
+
+def check_gain(kind: str, K) -> float:
+    """K as a float in [0, MAX_GAIN[kind]]; a clear error otherwise."""
+    try:
+        k = float(K)
+    except (TypeError, ValueError):
+        raise InputError(f"--feedback needs a number, got {K!r}") from None
+    if kind not in MAX_GAIN:
+        raise InputError(f"unknown network {kind!r}: use {', '.join(MAX_GAIN)}")
+    if not (math.isfinite(k) and 0.0 <= k <= MAX_GAIN[kind]):
+        raise InputError(f"--feedback gain for the {kind} network must be a number in "
+                         f"[0, {MAX_GAIN[kind]:g}] (recommended {RECOMMENDED[kind]:g}), got {K}")
+    return k
+
+
+@dataclass
+class LoopNetwork:
+    """What the compiled loop needs to step a network: its kind code, its parameters as a flat
+    array (layout per kind in :func:`advance`), its state, the activation map
+    a = 1 / (1 + exp(-(v - act_centre) / act_width)), the RK4 step (model units) and steps per
+    tick, the gain, and (Matsuoka) the noise rows, one per 1 ms step."""
+
+    code: int
+    P: np.ndarray
+    y: np.ndarray
+    act_centre: float
+    act_width: float
+    h: float
+    n_sub: int
+    gain: float
+    noise: np.ndarray  # (steps, 12) or (0, 12)
+
+
+def loop_network(network, K: float, tick_s: float, seconds: float) -> LoopNetwork:
+    """The network ready to be stepped in a closed loop of ``tick_s``-second ticks for
+    ``seconds`` (at most)."""
+    spec = network.loop_spec()
+    code, P, act_c, act_w = spec["code"], spec["P"], spec["act_centre"], spec["act_width"]
+    unit = network.units_per_s * tick_s  # model units per tick
+    n_sub = int(math.ceil(unit / network.dt - 1e-9))
+    noise = np.zeros((0, 12))
+    if code == KIND_MATSUOKA and spec["L"] > 0:
+        n_steps = int(round((seconds + 0.1) / network.dt))
+        rng = np.random.default_rng(spec["seed"])  # the open-loop sequence (cpg.matsuoka)
+        noise = spec["L"] * rng.standard_normal((n_steps + 1, 1, 12))[:, 0, :]
+    return LoopNetwork(code, np.ascontiguousarray(P, dtype=float),
+                       np.array(network.y0, dtype=float), float(act_c), float(act_w),
+                       unit / n_sub, n_sub, float(K), np.ascontiguousarray(noise))
+
+
+# ----------------------------------------------------------------------------- kernels
+@njit(cache=True, inline="always")
+def _sigmoid(x):
+    x = min(60.0, max(-60.0, x))
+    return 1.0 / (1.0 + math.exp(-x))
+
+
+@njit(cache=True)
+def inputs(code, K, y, sensors, inp):
+    """The feedback term of each ankle cell (LF, RF, LE, RE) from the sensors
+    (n_L, n_R, q_L, q_R), into ``inp``: Morris-Lecar the current, Hopf the added angular
+    velocity K n_l cos(theta) (rad/s; reported, the integration recomputes it in every stage),
+    Matsuoka the input over tau / k_f, in units of r (times r in the equation)."""
+    for c in range(4):
+        inp[c] = 0.0
+    for leg in range(2):
+        n = sensors[leg]
+        if code == KIND_ML:
+            inp[2 + leg] = K * (n - 0.5)
+        elif code == KIND_HOPF:
+            x, v = y[2 + leg], y[6 + leg]
+            r = math.sqrt(x * x + v * v) + 1e-12
+            inp[2 + leg] = K * n * x / r
+        else:
+            s = -sensors[2 + leg] / THETA_REF
+            inp[leg] = K * s
+            inp[2 + leg] = -K * s
+
+
+@njit(cache=True, inline="always")
+def _ml_rhs(y, dy, P, colsum, inp):
+    # P: [i_app, phi, W (4x4 row-major, W[j, i] donor j, receiver i)]
+    Wb = P[2:18].reshape((4, 4))
+    _ml_f(y, dy, P[0], P[1], Wb, colsum)
+    for i in range(4):
+        dy[4 + i] += inp[i]
+
+
+@njit(cache=True, inline="always")
+def _hopf_fb_rhs(y, dy, P, C, S, kn):
+    # P: [mu, alpha, omega_st, omega_sw, a, k, normalised]; C, S: cos/sin of theta_ij
+    _hopf_rhs(y, dy, P[0], P[1], P[2], P[3], P[4], P[5], P[6] > 0.5, C, S)
+    for leg in range(2):
+        i = 2 + leg
+        if kn[leg] != 0.0:
+            x, v = y[i], y[4 + i]
+            r = math.sqrt(x * x + v * v) + 1e-12
+            dw = kn[leg] * x / r
+            dy[i] -= dw * v
+            dy[4 + i] += dw * x
+
+
+ANKLE = (5, 11, 4, 10)  # Matsuoka neurons of LF, RF, LE, RE (cpg.network.MATSUOKA_ANKLE)
+
+
+@njit(cache=True, inline="always")
+def _mt_rhs(y, dy, P, noise_row, inp):
+    # P: [tau, T, beta, r, L, k_f, k_i, W (12x12 row-major, W[i, j] donor j, receiver i)]
+    tau, T, beta, r, k_f, k_i = P[0], P[1], P[2], P[3], P[5], P[6]
+    rate = k_f / tau
+    for i in range(12):
+        acc = -y[i] - beta * y[12 + i] + k_i * r
+        for j in range(12):
+            xj = y[j]
+            if xj > 0.0:
+                acc += P[7 + 12 * i + j] * xj
+        if noise_row.shape[0] > 0:
+            acc += noise_row[i]
+        dy[i] = rate * acc
+        dy[12 + i] = (max(y[i], 0.0) - y[12 + i]) / T
+    for c in range(4):
+        dy[ANKLE[c]] += rate * r * inp[c]
+
+
+@njit(cache=True)
+def advance(code, P, y, K, sensors, n_sub, h, noise, step0, inp, scratch):
+    """Advance state y by n_sub RK4 steps of h model units with the feedback of ``sensors``
+    held (``inp`` receives the feedback terms, see :func:`inputs`). ``step0``: index of the
+    first 1 ms step (Matsuoka noise row). ``scratch``: (6, 24) work space. Returns False when
+    the state left the network's range (the caller stops)."""
+    inputs(code, K, y, sensors, inp)
+    D = y.shape[0]
+    k1, k2, k3, k4, tmp = scratch[0, :D], scratch[1, :D], scratch[2, :D], scratch[3, :D], scratch[4, :D]
+    if code == KIND_ML:
+        colsum = np.zeros(4)
+        for j in range(4):
+            for i in range(4):
+                colsum[i] += P[2 + 4 * j + i]
+        for _ in range(n_sub):
+            _ml_rhs(y, k1, P, colsum, inp)
+            for q in range(D):
+                tmp[q] = y[q] + 0.5 * h * k1[q]
+            _ml_rhs(tmp, k2, P, colsum, inp)
+            for q in range(D):
+                tmp[q] = y[q] + 0.5 * h * k2[q]
+            _ml_rhs(tmp, k3, P, colsum, inp)
+            for q in range(D):
+                tmp[q] = y[q] + h * k3[q]
+            _ml_rhs(tmp, k4, P, colsum, inp)
+            for q in range(D):
+                y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
+        bound = 1.5  # cpg.integrate.ML_RANGE
+    elif code == KIND_HOPF:
+        C = P[7:23].reshape((4, 4))
+        S = P[23:39].reshape((4, 4))
+        kn = np.empty(2)
+        for leg in range(2):
+            kn[leg] = K * sensors[leg]
+        for _ in range(n_sub):
+            _hopf_fb_rhs(y, k1, P, C, S, kn)
+            for q in range(D):
+                tmp[q] = y[q] + 0.5 * h * k1[q]
+            _hopf_fb_rhs(tmp, k2, P, C, S, kn)
+            for q in range(D):
+                tmp[q] = y[q] + 0.5 * h * k2[q]
+            _hopf_fb_rhs(tmp, k3, P, C, S, kn)
+            for q in range(D):
+                tmp[q] = y[q] + h * k3[q]
+            _hopf_fb_rhs(tmp, k4, P, C, S, kn)
+            for q in range(D):
+                y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
+        bound = 1e6
+    else:
+        empty = np.empty(0)
+        for s in range(n_sub):
+            row = noise[step0 + s] if noise.shape[0] > step0 + s else empty
+            _mt_rhs(y, k1, P, row, inp)
+            for q in range(D):
+                tmp[q] = y[q] + 0.5 * h * k1[q]
+            _mt_rhs(tmp, k2, P, row, inp)
+            for q in range(D):
+                tmp[q] = y[q] + 0.5 * h * k2[q]
+            _mt_rhs(tmp, k3, P, row, inp)
+            for q in range(D):
+                tmp[q] = y[q] + h * k3[q]
+            _mt_rhs(tmp, k4, P, row, inp)
+            for q in range(D):
+                y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
+        bound = 1e6
+    for q in range(D):
+        if not (abs(y[q]) < bound):
+            return False
+    return True
+
+
+@njit(cache=True)
+def outputs(code, y, act_centre, act_width, v, a):
+    """The four ankle cells' outputs v (LF, RF, LE, RE) and activations a of state y."""
+    for c in range(4):
+        if code == KIND_MATSUOKA:
+            v[c] = max(y[ANKLE[c]], 0.0)
+        else:
+            v[c] = y[4 + c]
+        a[c] = _sigmoid((v[c] - act_centre) / act_width)
+
+
+def run_open(net: LoopNetwork, n_ticks: int, sensors: np.ndarray | None = None) -> np.ndarray:
+    """The stepped network alone for n_ticks ticks, sensors (n_ticks, 4) held per tick (zeros
+    by default); outputs v (n_ticks + 1, 4) at the ticks. For tests and phase response."""
+    y = net.y.copy()
+    v, a = np.empty(4), np.empty(4)
+    out = np.empty((n_ticks + 1, 4))
+    inp, scratch = np.zeros(4), np.zeros((6, 24))
+    outputs(net.code, y, net.act_centre, net.act_width, v, a)
+    out[0] = v
+    s = np.zeros(4)
+    for k in range(n_ticks):
+        if sensors is not None:
+            s = np.ascontiguousarray(sensors[k], dtype=float)
+        if not advance(net.code, net.P, y, net.gain, s, net.n_sub, net.h, net.noise,
+                       k * net.n_sub, inp, scratch):
+            out[k + 1:] = np.nan
+            break
+        outputs(net.code, y, net.act_centre, net.act_width, v, a)
+        out[k + 1] = v
+    return out
