@@ -52,8 +52,10 @@ so that it is today's rollout bit for bit.
 """
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -63,12 +65,31 @@ from .hopf import _rhs4 as _hopf_rhs
 from .integrate import _ml_f
 
 KIND_ML, KIND_HOPF, KIND_MATSUOKA = 0, 1, 2
+# The alternative Morris-Lecar form, measured against the chosen one (scripts/feedback_choice.py):
+# each flexor also receives -K (n_l - 1/2).
+KIND_ML_ANTAGONIST = 3
+# ... and the Morris-Lecar cells with Taga's contact-gated thigh angle (the Matsuoka form).
+KIND_ML_ANGLE = 4
+ML_FORMS = {"load": KIND_ML, "load_antagonist": KIND_ML_ANTAGONIST, "angle": KIND_ML_ANGLE}
 LOAD_CONTACT = 0.05  # body weights: a foot carrying more is on the ground (gate c_l)
 THETA_REF = 0.3  # rad: Taga's thigh-angle scale for the Matsuoka pathway
-# The recommended gain of each network (``--feedback`` without a value); chosen by measurement
-# (scripts/feedback_choice.py, README feedback section); units as in the equations above.
-RECOMMENDED = {"ml": 0.05, "hopf": 2.0, "matsuoka": 0.3}
 MAX_GAIN = {"ml": 1.0, "hopf": 50.0, "matsuoka": 5.0}  # beyond these the network is swamped
+# Each network's pathway (Morris-Lecar: one of ML_FORMS) and recommended gain (``--feedback``
+# without a value), chosen by measurement: the data file scripts/feedback_choice.py writes.
+GAINS_FILE = Path(__file__).with_name("feedback_gains.json")
+
+
+def _read_choice(path=GAINS_FILE) -> dict:
+    try:
+        d = json.loads(Path(path).read_text())
+        return {k: (str(v["form"]), float(v["recommended_gain"]))
+                for k, v in d["networks"].items()}
+    except (OSError, ValueError, KeyError, TypeError) as e:  # pragma: no cover - shipped file
+        raise ImportError(f"cannot read the feedback choice {path}: {e}") from None
+
+
+CHOICE = _read_choice()
+RECOMMENDED = {k: g for k, (_, g) in CHOICE.items()}
 
 
 def check_gain(kind: str, K) -> float:
@@ -103,11 +124,20 @@ class LoopNetwork:
     noise: np.ndarray  # (steps, 12) or (0, 12)
 
 
-def loop_network(network, K: float, tick_s: float, seconds: float) -> LoopNetwork:
+def loop_network(network, K: float, tick_s: float, seconds: float,
+                 form: str | None = None) -> LoopNetwork:
     """The network ready to be stepped in a closed loop of ``tick_s``-second ticks for
-    ``seconds`` (at most)."""
+    ``seconds`` (at most). ``form`` (Morris-Lecar only, one of :data:`ML_FORMS`): a pathway
+    other than the chosen one, for the measurement that chose it."""
     spec = network.loop_spec()
     code, P, act_c, act_w = spec["code"], spec["P"], spec["act_centre"], spec["act_width"]
+    if form is None and code == KIND_ML:
+        form = CHOICE["ml"][0]
+    if form is not None:
+        if code != KIND_ML or form not in ML_FORMS:
+            raise InputError(f"feedback forms {', '.join(ML_FORMS)} are the Morris-Lecar "
+                             f"network's")
+        code = ML_FORMS[form]
     unit = network.units_per_s * tick_s  # model units per tick
     n_sub = int(math.ceil(unit / network.dt - 1e-9))
     noise = np.zeros((0, 12))
@@ -139,11 +169,14 @@ def inputs(code, K, y, sensors, inp):
         n = sensors[leg]
         if code == KIND_ML:
             inp[2 + leg] = K * (n - 0.5)
+        elif code == KIND_ML_ANTAGONIST:
+            inp[2 + leg] = K * (n - 0.5)
+            inp[leg] = -K * (n - 0.5)
         elif code == KIND_HOPF:
             x, v = y[2 + leg], y[6 + leg]
             r = math.sqrt(x * x + v * v) + 1e-12
             inp[2 + leg] = K * n * x / r
-        else:
+        else:  # Matsuoka, and the Morris-Lecar angle form: Taga's gated thigh angle
             s = -sensors[2 + leg] / THETA_REF
             inp[leg] = K * s
             inp[2 + leg] = -K * s
@@ -203,7 +236,7 @@ def advance(code, P, y, K, sensors, n_sub, h, noise, step0, inp, scratch):
     inputs(code, K, y, sensors, inp)
     D = y.shape[0]
     k1, k2, k3, k4, tmp = scratch[0, :D], scratch[1, :D], scratch[2, :D], scratch[3, :D], scratch[4, :D]
-    if code == KIND_ML:
+    if code == KIND_ML or code == KIND_ML_ANTAGONIST or code == KIND_ML_ANGLE:
         colsum = np.zeros(4)
         for j in range(4):
             for i in range(4):

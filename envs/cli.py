@@ -87,6 +87,28 @@ def seed_arg(text: str) -> int:
     return v
 
 
+def feedback_arg(text: str) -> float:
+    """A feedback gain K >= 0 (its upper bound depends on the network: checked later)."""
+    if text == "recommended":  # --feedback without a value (argparse passes const through)
+        return text
+    return _number(text, 0.0, 1e300, False, "must be a feedback gain K >= 0 (a finite number)")
+
+
+FEEDBACK_HELP = ("feed the body's sensors back into the CPG, stepped with the physics "
+                 "(cpg.feedback); --feedback alone: the network's recommended gain, "
+                 "--feedback K: gain K; without it the network runs open loop (K = 0)")
+
+
+def feedback_gain(a, kind: str) -> float:
+    """The gain of --feedback [K] for a network of ``kind`` (0 without the option)."""
+    from cpg.feedback import RECOMMENDED, check_gain
+
+    k = getattr(a, "feedback", None)
+    if k is None:
+        return 0.0
+    return check_gain(kind, RECOMMENDED[kind] if k == "recommended" else k)
+
+
 def count_arg(lo: int):
     def parse(text: str) -> int:
         try:
@@ -264,7 +286,7 @@ def cmd_optimize_physics(a) -> int:
     pop = 32 if a.pop is None else a.pop
     gens = 20 if a.gens is None else a.gens
     rs = RunSettings(pop, gens, a.seed, a.checkpoint_every)
-    settings = default_settings(gait, a.froude, a.seconds, a.trials)
+    settings = default_settings(gait, a.froude, a.seconds, a.trials, feedback_gain(a, "ml"))
     args = (settings.seconds, settings.settle_s)
     if a.dask is not None:
         runner = DaskRunner(*args, address=None if a.dask == "local" else a.dask)
@@ -342,7 +364,7 @@ def cmd_optimize(a) -> int:
         return cmd_optimize_physics(a)
     a.pop = 40 if a.pop is None else a.pop
     a.gens = 25 if a.gens is None else a.gens
-    for opt in ("froude", "seconds", "trials", "workers"):
+    for opt in ("froude", "seconds", "trials", "workers", "feedback"):
         if getattr(a, opt) is not None:
             raise _input_error(f"--{opt} belongs to optimize --physics")
     from cpg.evaluate import SimSettings
@@ -465,11 +487,12 @@ def _validation(a, stop_on_fall=True, settle_s=None):
     check_gait(a.gait)
     net, label = _network(a)
     net.period()  # a network without a rhythm cannot drive the body: one line, before any work
+    K = feedback_gain(a, net.kind)
     v = validate(net, a.gait, a.seconds, friction_scale=a.friction_scale,
                  push=getattr(a, "push", None), stop_on_fall=stop_on_fall,
                  settle_s=SETTLE_S if settle_s is None else settle_s,
-                 ankle_drive=not a.no_ankle_drive)
-    return v, label
+                 ankle_drive=not a.no_ankle_drive, feedback=K)
+    return v, label + (f", feedback K = {K:g}" if K else "")
 
 
 def _input_error(msg):
@@ -549,13 +572,14 @@ def cmd_matrix(a) -> int:
     from cpg import io
     from envs.matrix import matrix, matrix_table
 
-    res = matrix(a.network, seconds=a.seconds, seed=a.seed, workers=a.workers)
+    K = feedback_gain(a, a.network)
+    res = matrix(a.network, seconds=a.seconds, seed=a.seed, workers=a.workers, feedback=K)
     if a.json:
         print(io.to_json(res))
     else:
         print(f"every {a.network} preset through the one controller ({a.seconds:g} s after "
               f"settling" + (f", random initial CPG state from seed {a.seed}" if a.seed is not None
-                            else "") + "):")
+                            else "") + (f", feedback K = {K:g}" if K else "") + "):")
         print(matrix_table(res))
     return 0
 
@@ -569,6 +593,64 @@ def cmd_check_pareto(a) -> int:
                        rrd=a.rrd, workers=a.workers, progress=not a.quiet)
     print(res["markdown"])
     print(f"wrote {a.out}/pareto_check.md, .csv, .json")
+    return 0
+
+
+def _gains_to_compare(a, kind: str) -> list[float]:
+    K = feedback_gain(a, kind)
+    return [0.0] if K == 0 else [0.0, K]
+
+
+def cmd_robustness(a) -> int:
+    from cpg import io
+    from envs.robustness import envelope_picture, robustness, table
+    from envs.validate import check_gait
+
+    check_gait(a.gait)
+    out_dir(a.out)
+    net, label = _network(a)
+    net.period()
+    gains = _gains_to_compare(a, net.kind)
+    res = robustness(net, a.gait, gains)
+    res["source"] = label
+    stem = os.path.join(a.out, f"robustness_{net.kind}_{net.preset}")
+    io.write_json(stem + ".json", res)
+    envelope_picture(res, stem + ".png")
+    if a.json:
+        print(io.to_json(res))
+    else:
+        print(f"{label}: push envelope (impulse survived, N s, at stride phases), friction "
+              f"x0.5/0.7/1.3/2.0 and 8 random CPG states; target {a.gait}")
+        print(table(res))
+        print(f"wrote {stem}.json, {stem}.png")
+    return 0
+
+
+def cmd_phase_response(a) -> int:
+    from cpg import io
+    from envs.phase_response import phase_response, picture
+    from envs.validate import check_gait
+
+    check_gait(a.gait)
+    out_dir(a.out)
+    net, label = _network(a)
+    net.period()
+    res = [phase_response(net, K, impulse=a.impulse) for K in _gains_to_compare(a, net.kind)]
+    stem = os.path.join(a.out, f"phase_response_{net.kind}_{net.preset}")
+    io.write_json(stem + ".json", {"source": label, "by_gain": res})
+    picture(res, f"{label}: {a.impulse:g} N s push forwards", stem + ".png")
+    if a.json:
+        print(io.to_json({"source": label, "by_gain": res}))
+    else:
+        for r in res:
+            f = lambda xs: " ".join("-" if x is None or x != x else f"{x:+.3f}"  # noqa: E731
+                                    for x in xs) if xs is not None else r.get("note", "")
+            print(f"K = {r['feedback_gain']:g}: CPG phase shift (cycles) at push phases "
+                  f"{' '.join(f'{p:g}' for p in r['phases'])}: {f(r['dphi'])}")
+            if r["relock_cycles"] is not None:
+                print("  cycles to re-lock: " + " ".join(
+                    "-" if x is None else f"{x:g}" for x in r["relock_cycles"]))
+        print(f"wrote {stem}.json, {stem}.png")
     return 0
 
 
@@ -625,6 +707,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="remove the CPG's ankle drive (the reflexes stay): the ablation")
         sp.add_argument("--rrd", required=rrd_required, metavar="FILE.rrd",
                         help="also write a rerun recording")
+        sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended",
+                        default=None, metavar="K", help=FEEDBACK_HELP)
 
     sp = add("validate", cmd_validate, "drive the biped with a network and measure the gait", """\
         A network (--network, --preset, --weights; default the Morris-Lecar preset of --gait)
@@ -653,6 +737,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=20.0,
                     help="simulated seconds after 2 s of settling (default 20)")
     sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
+    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
+                    metavar="K", help=FEEDBACK_HELP)
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("render", cmd_render, "render a rollout off-screen to mp4", """\
@@ -680,6 +766,50 @@ def build_parser() -> argparse.ArgumentParser:
         diagram above the CPG signals. Open it with 'rerun FILE.rrd'.""")
     rollout_args(sp, rrd_required=True)
     sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"))
+
+    def network_args(sp):
+        sp.add_argument("--gait", default="walk",
+                        help="the gait checked in the conditions: walk, run, jump or hop "
+                             "(default walk)")
+        sp.add_argument("--network", default="ml", choices=("ml", "hopf", "matsuoka"),
+                        help="the network that drives the body (default ml: Morris-Lecar)")
+        sp.add_argument("--preset", default=None,
+                        help="the network's preset (default: the --gait; matsuoka: walk)")
+        sp.add_argument("--weights", metavar="FILE",
+                        help="optimiser result JSON: its chosen (w_a, w_b, w_c), I_app and phi "
+                             "replace the Morris-Lecar preset's")
+        sp.add_argument("--seed", type=seed_arg, default=None,
+                        help="random initial CPG state from this seed (default: the preset's)")
+        sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended",
+                        default=None, metavar="K", help=FEEDBACK_HELP)
+
+    sp = add("robustness", cmd_robustness, "push envelope, friction and CPG-state survival",
+             """\
+        The robustness envelope of a gait, as SCONE's perturbation tutorials measure it:
+        horizontal pushes on the torso at four phases of the stride (after 6 s; phase 0 a
+        left touchdown), forwards and backwards, the impulse climbing 2.5, 5, 7.5, ... 40 N s
+        until the body falls within 5 s; floor friction x0.5, 0.7, 1.3, 2.0; eight random
+        initial CPG states (seeds 20-27). With --feedback, open loop (K = 0) and the gain K
+        side by side. Writes --out/robustness_<network>_<preset>.json and .png (impulse
+        survived against the phase of the push).""")
+    network_args(sp)
+    sp.add_argument("--out", default="out/robustness", metavar="DIR",
+                    help="folder for the JSON and the picture (default out/robustness)")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+
+    sp = add("phase-response", cmd_phase_response, "how far a push moves the CPG's phase",
+             """\
+        Phase response of the coupled CPG and body: a horizontal push on the torso at ten
+        phases of the stride; the CPG's phase shift (cycles, + advanced) 4-7 cycles later
+        against the unpushed rollout, and the CPG cycles until the body's touchdowns lock
+        to the CPG's bursts again. Open loop the CPG's phase cannot move; with --feedback
+        it can. Writes --out/phase_response_<network>_<preset>.json and .png.""")
+    network_args(sp)
+    sp.add_argument("--impulse", type=finite_arg, default=5.0, metavar="NS",
+                    help="push impulse, N s forwards (negative: backwards; default 5)")
+    sp.add_argument("--out", default="out/robustness", metavar="DIR",
+                    help="folder for the JSON and the picture (default out/robustness)")
+    sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("check-pareto", cmd_check_pareto, "run an optimiser result's Pareto points in physics",
              """\
@@ -772,6 +902,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "the gait (N+1 integrations per individual)")
     sp.add_argument("--lock-time-objective", action="store_true",
                     help="add the objective: model time until the phases stay within 2 deg")
+    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
+                    metavar="K", help="--physics only: " + FEEDBACK_HELP)
     sp.add_argument("--out", default="out/optimize", help="output folder (default out/optimize)")
     sp.add_argument("--quiet", action="store_true", help="no progress bar")
 

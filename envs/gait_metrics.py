@@ -42,7 +42,7 @@ def debounce(contact: np.ndarray, dt: float, min_phase_s: float = MIN_PHASE_S) -
     interior run is short (the first and last runs may be cut by the window, so they stay).
     """
     c = np.asarray(contact, dtype=bool).copy()
-    n_min = max(1, int(round(min_phase_s / dt)))
+    n_min = max(1, int(round(min_phase_s / dt))) if dt > 0 else 1  # dt 0: one sample
     if len(c) >= 2:
         _debounce_inplace(c, n_min)
     return c

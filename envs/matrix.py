@@ -22,16 +22,17 @@ KEYS = ("physical_gait", "cpg_gait", "fell", "fell_at_s", "duty_factor", "lr_pha
 def _row(args) -> dict:
     from .validate import validate
 
-    kind, preset, seed, seconds = args
+    kind, preset, seed, seconds, feedback = args
     net = build(kind, preset, seed=seed)
     net.period()
-    s = validate(net, None, seconds).summary()
+    s = validate(net, None, seconds, feedback=feedback).summary()
     return {k: s[k] for k in KEYS}
 
 
 def matrix(kind: str = "ml", seconds: float = 20.0, seed: int | None = None,
-           workers: int = 2) -> dict:
-    """{"network": kind, "rows": {preset: {physical_gait, fell, ...metrics}}}."""
+           workers: int = 2, feedback: float = 0.0) -> dict:
+    """{"network": kind, "rows": {preset: {physical_gait, fell, ...metrics}}}; ``feedback``:
+    the gain K of the body's feedback into the CPG (0: open loop)."""
     if kind not in KINDS:
         raise InputError(f"unknown network {kind!r}: use {', '.join(KINDS)}")
     check_seconds(seconds)
@@ -41,7 +42,10 @@ def matrix(kind: str = "ml", seconds: float = 20.0, seed: int | None = None,
         raise InputError(f"--workers must be at least 1, got {workers}")
     for p in PRESETS[kind]:  # a clear error before any process starts
         build(kind, p, seed=seed)
-    jobs = [(kind, p, seed, seconds) for p in PRESETS[kind]]
+    from cpg.feedback import check_gain
+
+    feedback = check_gain(kind, feedback)
+    jobs = [(kind, p, seed, seconds, feedback) for p in PRESETS[kind]]
     if workers == 1 or len(jobs) == 1:
         rows = [_row(j) for j in jobs]
     else:
@@ -50,7 +54,7 @@ def matrix(kind: str = "ml", seconds: float = 20.0, seed: int | None = None,
         ctx = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=ctx) as ex:
             rows = list(ex.map(_row, jobs))
-    return {"network": kind, "seed": seed, "seconds": seconds,
+    return {"network": kind, "seed": seed, "seconds": seconds, "feedback_gain": feedback,
             "rows": dict(zip(PRESETS[kind], rows))}
 
 

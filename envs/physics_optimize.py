@@ -144,11 +144,12 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
 
 
 def default_settings(gait: str, froude: float | None = None, seconds: float | None = None,
-                     n_trials: int | None = None) -> PhysicsSettings:
+                     n_trials: int | None = None, feedback: float = 0.0) -> PhysicsSettings:
     """The settings of a run, each left as None taking its default (:class:`PhysicsSettings`;
     the Froude target from :data:`FROUDE_TARGET`)."""
     check_gait(gait)
     d = PhysicsSettings(FROUDE_TARGET[gait])
     return PhysicsSettings(d.froude if froude is None else float(froude),
                            d.seconds if seconds is None else float(seconds),
-                           n_trials=d.n_trials if n_trials is None else int(n_trials))
+                           n_trials=d.n_trials if n_trials is None else int(n_trials),
+                           feedback=float(feedback))

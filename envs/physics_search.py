@@ -70,6 +70,7 @@ class PhysicsSettings:
     seconds: float = 20.0
     settle_s: float = SETTLE_S
     n_trials: int = 4
+    feedback: float = 0.0  # gain K of the body's feedback into the CPG (cpg.feedback)
 
     def __post_init__(self):
         if not (np.isfinite(self.froude) and self.froude > 0):
@@ -104,11 +105,13 @@ def perturbations(gait: str, settings: PhysicsSettings, seed: int) -> list[dict]
     return out
 
 
-def trials_of(gait: str, x: np.ndarray, conditions: list[dict]) -> list[Trial]:
+def trials_of(gait: str, x: np.ndarray, conditions: list[dict],
+              feedback: float = 0.0) -> list[Trial]:
     """The unperturbed trial of parameter vector x (w_a, w_b, w_c, i_app, phi), then one per
-    perturbation condition."""
+    perturbation condition; every one with the feedback gain ``feedback``."""
     w, i_app, phi = tuple(float(v) for v in x[:3]), float(x[3]), float(x[4])
-    return [Trial(gait, w, i_app, phi)] + [Trial(gait, w, i_app, phi, **c) for c in conditions]
+    return [Trial(gait, w, i_app, phi, feedback=feedback)] + [
+        Trial(gait, w, i_app, phi, **c, feedback=feedback) for c in conditions]
 
 
 def cost_of(gait: str, r: TrialResult) -> float:
@@ -176,7 +179,8 @@ class PhysicsGaitProblem(Problem):
         """(F (P, 3), G (P,), per-point trial results) of parameter vectors X (P, 5)."""
         X = np.atleast_2d(np.asarray(X, float))
         per = 1 + len(self.conditions)
-        trials = [t for x in X for t in trials_of(self.gait, x, self.conditions)]
+        trials = [t for x in X for t in trials_of(self.gait, x, self.conditions,
+                                                  self.settings.feedback)]
         results = self.runner(trials)
         groups = [results[k * per:(k + 1) * per] for k in range(len(X))]
         scored = [score(self.gait, self.settings, g) for g in groups]

@@ -13,6 +13,8 @@ Entities, per rollout under ``/<name>`` (e.g. ``/walk``):
   activation                          ankle muscle activations, series LF, RF, LE, RE
   joints                              hip, knee, ankle angles (rad), series <leg>_<joint>
   torso                               series height (m), pitch (rad)
+  feedback                            closed loop only: the feedback term each cell receives
+                                      (cpg.feedback), series LF, RF, LE, RE
   events/<leg>/touchdown|liftoff      1.0 at each event time
   metrics                             the gait metrics as a Markdown document (static)
   video                               the rendered video as an asset (optional)
@@ -107,7 +109,9 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
             ("force", LEGS, rec.force, [FOOT_COLORS[leg] for leg in LEGS]),
             ("cpg", CELLS, rec.cpg_v, CELL_COLORS), ("activation", CELLS, rec.activation, CELL_COLORS),
             ("joints", JOINTS, rec.joints, JOINT_COLORS),
-            ("torso", ("height", "pitch"), torso, CELL_COLORS[:2])):
+            ("torso", ("height", "pitch"), torso, CELL_COLORS[:2])) + (
+            (("feedback", CELLS, rec.feedback, CELL_COLORS),)
+            if rec.feedback_gain > 0 and len(rec.feedback) == len(t) else ()):
         rs.log(f"/{name}/{path}", rr.SeriesLines(names=list(names), colors=list(colors)),
                static=True)
         _columns(rs, f"/{name}/{path}", t, x)
@@ -183,7 +187,9 @@ def blueprint(rollouts: dict, videos: dict | None = None):
                  rrb.TimeSeriesView(origin=f"/{n}/cpg", name=f"{n}: CPG cells",
                                     time_ranges=follow),
                  rrb.TimeSeriesView(origin=f"/{n}/activation", name=f"{n}: ankle muscles",
-                                    time_ranges=follow),
+                                    time_ranges=follow)] + ([
+                 rrb.TimeSeriesView(origin=f"/{n}/feedback", name=f"{n}: feedback into the CPG",
+                                    time_ranges=follow)] if rec.feedback_gain > 0 else []) + [
                  rrb.TimeSeriesView(origin=f"/{n}/joints", name=f"{n}: joint angles",
                                     time_ranges=follow),
                  rrb.TextDocumentView(origin=f"/{n}/metrics", name=f"{n}: metrics")]

@@ -84,7 +84,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
             stop_on_fall: bool = True, ankle_drive: bool = True,
             to: Network | None = None, change: Schedule | None = None,
             xml_path: str | Path = BIPED_SCENE, poses: bool = True,
-            feedback: float = 0.0) -> Recording:
+            feedback: float = 0.0, feedback_form: str | None = None) -> Recording:
     """Run the CPG-driven biped for ``seconds`` of simulated time.
 
     Every tick records the joint positions and every body's world pose (forward kinematics of
@@ -112,7 +112,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     dt = m.opt.timestep
     if K > 0:
         ctrl = CPGController(m, d, None, params,
-                             loop=loop_network(network, K, dt * CONTROL_EVERY, seconds))
+                             loop=loop_network(network, K, dt * CONTROL_EVERY, seconds,
+                                               feedback_form))
     else:
         ctrl = CPGController(m, d, cpg_schedule(network, seconds, to=to, change=change), params)
     n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))

@@ -7,6 +7,7 @@ the one controller (:data:`envs.controller.CONTROL`); the task's name sets only 
 target speed.
 Action: 8 values in [-1, 1] added to the CPG controller's output (ankle muscles LF, RF, LE,
 RE then hips and knees) and clipped to the actuator ranges; a zero action is the pure CPG.
+``feedback=K`` closes the loop from the body into the CPG (:mod:`cpg.feedback`).
 Reward: upright (torso pitch within 0.3 rad, height above 0.7 m) times forward speed within
 the gait's target band (dm_control ``rewards.tolerance``).
 """
@@ -35,8 +36,11 @@ class CPGLocomotion(base.Task):
 
     def __init__(self, gait: str, network: Network, params: ControlParams = CONTROL,
                  random=None, random_cpg_state: bool = False, friction_scale: float = 1.0,
-                 time_limit: float = DEFAULT_TIME_LIMIT):
+                 time_limit: float = DEFAULT_TIME_LIMIT, feedback: float = 0.0):
         super().__init__(random=random)
+        from cpg.feedback import check_gain
+
+        self.feedback = check_gain(network.kind, feedback)
         self.gait, self.network, self.params = gait, network, params
         self.random_cpg_state = random_cpg_state
         self.friction_scale = friction_scale
@@ -50,8 +54,16 @@ class CPGLocomotion(base.Task):
         net = self.network
         if self.random_cpg_state:
             net = net.with_state(net.random_state(self.random))
-        sched = cpg_schedule(net, self.time_limit + 1.0)
-        self.controller = CPGController(physics.model.ptr, physics.data.ptr, sched, self.params)
+        if self.feedback > 0:  # the network stepped with the physics, one tick per control step
+            from cpg.feedback import loop_network
+
+            loop = loop_network(net, self.feedback, CONTROL_TIMESTEP, self.time_limit + 1.0)
+            self.controller = CPGController(physics.model.ptr, physics.data.ptr, None,
+                                            self.params, loop=loop)
+        else:
+            sched = cpg_schedule(net, self.time_limit + 1.0)
+            self.controller = CPGController(physics.model.ptr, physics.data.ptr, sched,
+                                            self.params)
         super().initialize_episode(physics)
 
     def before_step(self, action, physics: Physics):
@@ -74,6 +86,7 @@ class CPGLocomotion(base.Task):
         c = self.controller
         obs["cpg"] = np.array(c.last_v) if c is not None else np.zeros(4)
         obs["muscle_activation"] = np.array(physics.data.act[:4])
+        obs["cpg_feedback"] = c.feedback if c is not None else np.zeros(4)
         return obs
 
     def get_reward(self, physics: Physics):
@@ -87,8 +100,10 @@ class CPGLocomotion(base.Task):
 
 def load(name: str, weights: str | None = None, network: str = "ml", preset: str | None = None,
          time_limit: float = DEFAULT_TIME_LIMIT, random=None, random_cpg_state: bool = False,
-         friction_scale: float = 1.0, xml_path=None) -> control.Environment:
-    """An environment like ``suite.load``: walk, run, jump, hop, or free (with ``weights``)."""
+         friction_scale: float = 1.0, xml_path=None, feedback: float = 0.0) -> control.Environment:
+    """An environment like ``suite.load``: walk, run, jump, hop, or free (with ``weights``);
+    ``feedback``: the gain K of the body's feedback into the CPG (0: open loop; the network is
+    then stepped once per control step, :data:`CONTROL_TIMESTEP`)."""
     if name == "free":
         if weights is None:
             raise InputError("task 'free' needs a weights file (an optimiser result JSON)")
@@ -107,6 +122,6 @@ def load(name: str, weights: str | None = None, network: str = "ml", preset: str
         raise InputError(f"time_limit must be a positive number of seconds, got {time_limit}")
     physics = load_physics(xml_path) if xml_path else load_physics()
     task = CPGLocomotion(gait, net, CONTROL, random=random, random_cpg_state=random_cpg_state,
-                         friction_scale=friction_scale, time_limit=time_limit)
+                         friction_scale=friction_scale, time_limit=time_limit, feedback=feedback)
     return control.Environment(physics, task, time_limit=time_limit,
                                control_timestep=CONTROL_TIMESTEP)

@@ -40,6 +40,7 @@ class Trial:
     cpg_seed: int | None = None
     friction_scale: float = 1.0
     push: tuple[float, float] | None = None
+    feedback: float = 0.0  # gain K of the body's feedback into the CPG (cpg.feedback)
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,7 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         net = build("ml", trial.preset, weights=list(trial.weights), i_app=trial.i_app,
                     phi=trial.phi, seed=trial.cpg_seed)
         rec = rollout(net, total, friction_scale=trial.friction_scale, push=trial.push,
-                      stop_on_fall=stop_on_fall, poses=False)
+                      stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback)
     except InputError as e:  # a network that diverges cannot drive the body
         return _failed(str(e))
     v = measure_recording(net, None, rec, settle_s)

@@ -49,12 +49,25 @@ class Validation:
             "footfalls_per_stride": m.footfalls_per_stride,
             "ankle_excursion_deg": m.ankle_excursion_deg,
             "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
+            "feedback_gain": self.recording.feedback_gain,
+            "feedback_rms": _feedback_rms(self.recording, self.settle_s),
         }
         if self.biomech is not None:
             s.update(self.biomech.as_dict())
         s["failures"] = CRITERIA[self.gait].failures(s) if self.gait else []
         s["passed"] = bool(self.gait and not s["failures"])
         return s
+
+
+def _feedback_rms(rec: Recording, settle_s: float) -> dict:
+    """Root mean square of the feedback term each cell received after settling (zero open
+    loop); units of cpg.feedback's equations for the network."""
+    from cpg.morris_lecar import CELLS
+
+    sel = rec.t >= settle_s
+    fb = rec.feedback[sel] if len(rec.feedback) == len(rec.t) else np.zeros((0, 4))
+    rms = np.sqrt((fb ** 2).mean(axis=0)) if len(fb) else np.zeros(4)
+    return {c: float(x) for c, x in zip(CELLS, rms)}
 
 
 def _cpg_period_s(net: Network) -> float | None:
@@ -74,12 +87,14 @@ def validate(network: Network, gait: str | None = None, seconds: float = 20.0, *
              friction_scale: float = 1.0, push: tuple[float, float] | None = None,
              settle_s: float = SETTLE_S, stop_on_fall: bool = True, ankle_drive: bool = True,
              params: ControlParams = CONTROL, to: Network | None = None,
-             change: Schedule | None = None) -> Validation:
-    """Roll out ``settle_s + seconds`` and measure the gait over the last ``seconds``."""
+             change: Schedule | None = None, feedback: float = 0.0) -> Validation:
+    """Roll out ``settle_s + seconds`` and measure the gait over the last ``seconds``;
+    ``feedback``: the gain K of the body's feedback into the CPG (0: open loop)."""
     check_gait(gait)
     seconds = check_seconds(seconds)
     rec = rollout(network, seconds + settle_s, params, friction_scale=friction_scale, push=push,
-                  stop_on_fall=stop_on_fall, ankle_drive=ankle_drive, to=to, change=change)
+                  stop_on_fall=stop_on_fall, ankle_drive=ankle_drive, to=to, change=change,
+                  feedback=feedback)
     return measure_recording(network, gait, rec, settle_s, ankle_drive)
 
 
