@@ -56,7 +56,9 @@ MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
 # R_V: CPG outputs; R_DRIVE: their activations (the CPG's drive); R_ACT: the ankle muscles'
 # activation state (MjData.act); R_CTRL: the 8 controls sent; R_POWER: each actuator's
 # mechanical power (actuator force x actuator velocity, W; the actuator order of the model);
-# R_FB: the feedback term each cell receives (cpg.feedback.inputs; zero open loop).
+# R_FB: the feedback term each cell receives (cpg.feedback.inputs; zero open loop), computed
+# with the row's CPG outputs from the sensors of the row before (a row's state is measured at
+# the end of its tick).
 (R_T, R_CONTACT, R_FORCE, R_V, R_DRIVE, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX, R_COMZ,
  R_MODE, R_CTRL, R_POWER, R_FB) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37, 45)
 R_SIZE = 49

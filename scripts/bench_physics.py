@@ -2,7 +2,9 @@
 
 1. Physics steps per second with the CPG and the one controller in the loop (``rollout``: the
    CPG is integrated ahead in one batch, the controller runs every 2 physics steps) vs plain
-   ``mujoco.mj_step`` of the same model with zero control. Target ratio >= 0.5.
+   ``mujoco.mj_step`` of the same model with zero control. Target ratio >= 0.5. The same for
+   the closed loop (``rollout(feedback=K)``, the CPG stepped with the physics in the compiled
+   loop, ``poses=False``): target >= 0.5.
 2. Video frames per second of the renderer used by ``cpgbiped render`` vs a bare
    ``mujoco.Renderer`` loop over the same states with the same scene flags. Target >= 0.9x.
 3. Rollout time with the rerun recording (body included) written vs without. Target <= 1.2x.
@@ -68,6 +70,17 @@ def main(argv=None) -> int:
     print(f"   CPG + controller in the loop : {n_steps / t_loop:10.0f} steps/s")
     print(f"   plain mj_step, zero control  : {n_steps / t_plain:10.0f} steps/s")
     print(f"   ratio                        : {r_plain:10.2f}   (target >= 0.5)")
+
+    from cpg.feedback import RECOMMENDED
+
+    K = RECOMMENDED["ml"]
+    rollout(net, 0.5, poses=False, feedback=K)  # compile the closed loop
+    t_cl, t_plain2, r_cl = paired(7, lambda: rollout(net, a.seconds, poses=False, feedback=K),
+                                  plain)
+    print(f"1b. closed loop (feedback K = {K:g}, CPG stepped in the compiled loop):")
+    print(f"   closed loop                  : {n_steps / t_cl:10.0f} steps/s")
+    print(f"   plain mj_step, zero control  : {n_steps / t_plain2:10.0f} steps/s")
+    print(f"   ratio                        : {r_cl:10.2f}   (target >= 0.5)")
 
     from envs.render import FrameRenderer
 

@@ -82,9 +82,15 @@ def test_ankle_muscles_get_their_cells_at_one_gain():
 
 
 def test_the_controller_takes_no_gait_name():
-    """Its inputs are the CPG schedule, the parameters and MuJoCo's model and data."""
+    """Its inputs are the CPG schedule (or, closed loop, the network to step), the parameters
+    and MuJoCo's model and data; the network it steps is numbers only (no preset name)."""
+    from dataclasses import fields as dc_fields
+
+    from cpg.feedback import LoopNetwork
+
     names = set(inspect.signature(CPGController).parameters)
-    assert names == {"model", "data", "schedule", "params"}
+    assert names == {"model", "data", "schedule", "params", "loop"}
+    assert all(f.type in ("int", "float", "np.ndarray") for f in dc_fields(LoopNetwork))
     fields = " ".join(CONTROL.__dataclass_fields__)
     for word in ("gait", "walk", "run", "jump", "hop", "preset", "two_legged"):
         assert word not in fields

@@ -1,0 +1,231 @@
+"""Feedback from the body into the CPG: cpg.feedback, the closed loop in envs, robustness and
+phase response (issue 21)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cpg.errors import InputError
+from cpg.feedback import CHOICE, LOAD_CONTACT, RECOMMENDED, check_gain, loop_network, run_open
+from cpg.network import build
+from envs.rollout import rollout
+
+FIXTURE = Path(__file__).with_name("data") / "open_loop_rows.npz"
+# The rollouts recorded in the fixture (before the closed loop existed): network, preset, CPG
+# seed, push (time s, impulse N s); 2.5 s each, every 5th row, stop_on_fall=False.
+RECORDED = (("ml", "walk", None, None), ("ml", "jump", 3, (1.5, 4.0)),
+            ("hopf", "run", None, None), ("matsuoka", "walk", None, None))
+
+
+def _rows(rec) -> np.ndarray:
+    """The 45 columns a recording had before the feedback columns were added."""
+    return np.column_stack([rec.t, rec.contact, rec.force, rec.cpg_v, rec.drive, rec.activation,
+                            rec.joints, rec.torso_height, rec.torso_pitch, rec.com_x, rec.com_z,
+                            rec.modes, rec.ctrl, rec.power])
+
+
+@pytest.mark.parametrize("poses", [False, True], ids=["compiled loop", "python loop"])
+def test_zero_gain_reproduces_the_rows_recorded_before_feedback_existed(poses):
+    data = np.load(FIXTURE)
+    for kind, preset, seed, push in RECORDED:
+        rec = rollout(build(kind, preset, seed=seed), 2.5, push=push, poses=poses,
+                      stop_on_fall=False, feedback=0.0)
+        got, want = _rows(rec)[::5], data[f"{kind}_{preset}"]
+        assert got.shape == want.shape
+        assert np.array_equal(got, want), (kind, preset, float(np.nanmax(np.abs(got - want))))
+        assert rec.feedback_gain == 0.0 and not rec.feedback.any()
+
+
+@pytest.mark.parametrize("kind,preset,tol", [("ml", "walk", 5e-4), ("ml", "hop", 5e-4),
+                                             ("hopf", "run", 1e-9), ("matsuoka", "walk", 1e-9)])
+def test_the_stepped_network_without_input_follows_its_open_loop_integration(kind, preset, tol):
+    """The closed loop's integrator (4 ms ticks; Morris-Lecar 3 RK4 steps of 0.0164 units,
+    Hopf and Matsuoka 4 of 1 ms with the same noise) against the network's own open-loop
+    integration (Morris-Lecar step 0.02 units), interpolated to the ticks: 5 s."""
+    net = build(kind, preset)
+    v = run_open(loop_network(net, 0.0, 0.004, 5.0), 1250)
+    u = net.units_per_s
+    out = net.outputs(5.1 * u, record_every=max(1, int(round(0.002 * u / net.dt))))
+    t = np.arange(1251) * 0.004
+    ref = np.column_stack([np.interp(t, out.t_model / u, out.v[:, c]) for c in range(4)])
+    assert np.max(np.abs(v - ref)) < tol * np.ptp(ref)
+
+
+def test_closed_loop_compiled_and_python_loops_agree_bit_for_bit():
+    for kind in ("ml", "hopf", "matsuoka"):
+        net = build(kind, "walk")
+        K = RECOMMENDED[kind]
+        a = rollout(net, 3.0, poses=False, feedback=K)
+        b = rollout(net, 3.0, poses=True, feedback=K)
+        assert np.array_equal(_rows(a), _rows(b)) and np.array_equal(a.feedback, b.feedback)
+        assert a.feedback_gain == K and np.abs(a.feedback).max() > 0  # the loop is closed
+
+
+def test_an_unloaded_leg_silences_its_morris_lecar_extensor_under_load_feedback():
+    """Load form: dv_LE/dt += K (n_L - 1/2). A left leg that never carries load (n_L = 0) at
+    K = 0.5 gives the left extensor -0.25, more than its applied current (0.229): it falls
+    silent, while without feedback it bursts."""
+    net = build("ml", "walk")
+    sensors = np.tile([0.0, 0.5, 0.0, 0.0], (2500, 1))
+    act = lambda v: net.activation(v)[-750:, 2]  # noqa: E731  the last 3 s of LE
+    closed = run_open(loop_network(net, 0.5, 0.004, 10.0, form="load"), 2500, sensors)
+    opened = run_open(loop_network(net, 0.0, 0.004, 10.0, form="load"), 2500, sensors)
+    assert act(closed).max() < 0.5 < 0.9 < act(opened).max()
+
+
+def test_tegotae_holds_a_loaded_hopf_leg_in_its_burst():
+    """dtheta/dt += K n cos(theta): with K n above the burst's angular speed (omega_st = 8.4
+    rad/s for the walk) the loaded left extensor stops in the second half of its burst
+    (y > 0, activation > 1/2) instead of cycling."""
+    net = build("hopf", "walk")
+    assert 20.0 > net.p.omega_st
+    sensors = np.tile([1.0, 0.0, 0.0, 0.0], (2500, 1))
+    closed = net.activation(run_open(loop_network(net, 20.0, 0.004, 10.0), 2500, sensors))
+    opened = net.activation(run_open(loop_network(net, 0.0, 0.004, 10.0), 2500, sensors))
+    assert closed[-750:, 2].min() > 0.5
+    assert opened[-750:, 2].min() < 0.1
+
+
+def test_the_thigh_angle_pathway_is_gated_by_ground_contact():
+    """Taga form (the Morris-Lecar choice, and the Matsuoka network's): nothing reaches a
+    leg's cells while its foot carries less than LOAD_CONTACT body weights, and the flexor
+    receives the opposite of the extensor."""
+    from envs.biped import body_constants
+
+    assert CHOICE["ml"][0] == "angle"
+    rec = rollout(build("ml", "walk"), 6.0, poses=False, feedback=0.1)
+    weight = body_constants()[1] * 9.81
+    for leg in range(2):
+        air = rec.force[:, leg] / weight < LOAD_CONTACT
+        # a row's feedback was computed from the sensors of the row before it (the input of a
+        # tick, held over it; the row's force is measured at its end)
+        fb, air = rec.feedback[1:, [leg, 2 + leg]], air[:-1]
+        assert 0.2 < air.mean() < 0.8
+        assert not fb[air].any() and np.abs(fb[~air]).max() > 0.01
+        assert np.array_equal(fb[:, 0], -fb[:, 1])
+
+
+def test_the_phase_response_moves_the_cpg_only_with_feedback():
+    """Open loop the network never hears the body: a push leaves its phase exactly where it
+    was. With Tegotae feedback (Hopf run, K = 3) a 10 N s push moves it."""
+    from envs.phase_response import phase_response
+
+    net = build("hopf", "run")
+    open_, closed = (phase_response(net, K, phases=(0.1, 0.4), impulse=10.0) for K in (0.0, 3.0))
+    assert open_["dphi"] == [0.0, 0.0]
+    assert max(abs(x) for x in closed["dphi"]) > 0.05
+
+
+def _cli(*args, timeout=300):
+    env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "osmesa"))
+    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+                          text=True, timeout=timeout, env=env)
+
+
+@pytest.mark.parametrize("args,says", [
+    (("validate", "--feedback", "-1"), "K >= 0"),
+    (("validate", "--feedback", "nan"), "K >= 0"),
+    (("validate", "--feedback", "inf"), "K >= 0"),
+    (("validate", "--feedback", "2"), "[0, 1]"),
+    (("validate", "--network", "hopf", "--feedback", "1e9"), "[0, 50]"),
+    (("matrix", "--network", "spiking", "--feedback"), "invalid choice"),
+    (("robustness", "--feedback", "x"), "K >= 0"),
+    (("optimize", "--gait", "walk", "--feedback", "0.1"), "belongs to optimize --physics"),
+])
+def test_bad_feedback_input_is_one_line_and_exit_2(args, says):
+    r = _cli(*args, timeout=60)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cpgbiped: error:") and says in lines[0]
+    assert r.stdout == ""
+
+
+def test_feedback_cannot_be_combined_with_a_mid_run_parameter_change():
+    from cpg.integrate import Schedule
+
+    with pytest.raises(InputError, match="mid-run"):
+        rollout(build("ml", "walk"), 2.0, to=build("ml", "run"), change=Schedule.change(1.0),
+                feedback=0.01)
+    with pytest.raises(InputError):
+        check_gain("ml", float("nan"))
+
+
+def test_validate_json_reports_the_feedback_signals():
+    r = _cli("validate", "--gait", "run", "--seconds", "3", "--feedback", "--json")
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    assert s["feedback_gain"] == RECOMMENDED["ml"]
+    assert set(s["feedback_rms"]) == {"LF", "RF", "LE", "RE"}
+    assert min(s["feedback_rms"].values()) > 0
+
+
+def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fall(tmp_path):
+    """The command's envelope at one phase, checked against rollouts made here: the impulse it
+    reports is survived and the next one up the ladder is not."""
+    from envs.robustness import HOLD_S, IMPULSE_LADDER_NS, stride_phase
+
+    r = _cli("robustness", "--gait", "run", "--json", "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert (tmp_path / "robustness_ml_run.png").stat().st_size > 10_000
+    g = res["by_gain"][0]
+    assert g["feedback_gain"] == 0.0 and g["total"] == 12
+    best = g["push"]["forward"][0]
+    net = build("ml", "run")
+    sp = stride_phase(net, 0.0)
+    assert sp.t0_s == pytest.approx(g["push"]["stride"]["t0_s"])
+    nxt = IMPULSE_LADDER_NS[IMPULSE_LADDER_NS.index(best) + 1] if best else IMPULSE_LADDER_NS[0]
+    fell = lambda imp: rollout(net, sp.t0_s + HOLD_S, push=(sp.t0_s, imp),  # noqa: E731
+                               poses=False).fell_at is not None
+    assert (not best or not fell(best)) and fell(nxt)
+
+
+# -- what issue 21 asks and the closed loop does not reach (measured, README "Feedback") ----
+@pytest.mark.xfail(raises=AssertionError, strict=True,
+                   reason="with feedback (K = 0.01) the jump falls in 13 of the 13 test "
+                          "conditions (open loop 12 of 13): the jump's shortfall of issue 20, "
+                          "which the feedback does not repair")
+def test_the_jump_survives_the_test_conditions_with_feedback():
+    from tests.test_physics import CONDITIONS
+
+    fell = 0
+    for cond in CONDITIONS[:4]:
+        cond = dict(cond)
+        rec = rollout(build("ml", "jump", seed=cond.pop("seed", None)), 22.0, poses=False,
+                      feedback=RECOMMENDED["ml"], **cond)
+        fell += rec.fell_at is not None
+    assert fell == 0
+
+
+@pytest.mark.xfail(raises=AssertionError, strict=True,
+                   reason="push envelope with feedback K = 0.01 (smallest impulse survived over "
+                          "four stride phases): walk forwards 7.5 N s (0.36 N s/kg), as open "
+                          "loop; run forwards 5 N s (0.24 N s/kg), as open loop; neither twice "
+                          "the open loop's nor 0.5 N s/kg (10.5 N s)")
+def test_feedback_doubles_the_forward_push_envelope_or_reaches_half_a_newton_second_per_kg():
+    from envs.robustness import push_envelope
+
+    for preset in ("walk", "run"):
+        net = build("ml", preset)
+        o, c = (min(push_envelope(net, K)["forward"]) for K in (0.0, RECOMMENDED["ml"]))
+        assert c >= 2 * o or c >= 0.5 * 21.0, (preset, o, c)
+
+
+@pytest.mark.parametrize("preset", ["walk", "run", pytest.param("jump", marks=pytest.mark.xfail(
+    raises=AssertionError, strict=True,
+    reason="with feedback the jump falls at 4.1 s (open loop at 15.4 s): the 2.1 s of cell "
+           "outputs after settling are too few for the classifier (named none; kept running "
+           "after the fall, the closed-loop cells are named jump)")), "hop"])
+def test_the_cpg_classifier_names_each_preset_from_the_closed_loop_cells(preset):
+    """Feedback may move the network, but at the recommended gain the four cells still make
+    the preset's gait (the gait table's phases, named by cpg.gaits.classify)."""
+    from envs.validate import validate
+
+    v = validate(build("ml", preset), None, 20.0, feedback=RECOMMENDED["ml"])
+    assert v.cpg_gait == preset
