@@ -16,16 +16,21 @@ Sensors, per leg l (0 left, 1 right), measured at every control tick:
 Cells in the order LF, RF, LE, RE (flexor and extensor of the left and right ankle); for leg
 l its flexor is cell l and its extensor cell 2 + l. One gain K >= 0 scales every pathway.
 
-Morris-Lecar (load into the extensor's voltage equation, an input current in model units):
-    dv_{2+l}/dt += K (n_l - 1/2)
-  A loaded leg's extensor is depolarised and an unloaded one's hyperpolarised (load feedback
-  from the leg's extensors, Duysens & Pearson): stance lasts while the leg carries the body, a
-  landing excites the extensor. The term is zero for a leg carrying half the body weight, so
-  standing still (both feet, 1/2 each) leaves the network's rhythm as the paper's. The
-  flexors receive nothing directly: their coupling to the extensors (w_b, w_c) carries the
-  input on, whichever sign the preset gives it. Choice measured, not assumed: the variant
-  that also drives each flexor with -K (n_l - 1/2) is in ``scripts/feedback_choice.py``'s
-  output (README, feedback section).
+Morris-Lecar: three pathways were built and measured (input currents in model units); the
+chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuoka network:
+  "angle" (chosen): contact-gated thigh angle, a current into each cell of leg l:
+    dv_l/dt += K (-q_l / THETA_REF),    dv_{2+l}/dt += -K (-q_l / THETA_REF)
+    (a stance leg carried behind the hip depolarises its flexor and hyperpolarises its
+    extensor: time to swing; a leg placed ahead does the reverse);
+  "load": dv_{2+l}/dt += K (n_l - 1/2), the extensor depolarised by its leg's load (load
+    feedback from the extensors, Duysens & Pearson); zero for a leg carrying half the body,
+    so standing on both feet leaves the paper's rhythm;
+  "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2).
+  scripts/feedback_choice.py scored every form at K = 0.01, 0.03, 0.1 by the push envelope
+  of the walk and the run on tuning conditions (CPG seed 1000, pushes after 5.5 s), keeping
+  only gains at which the CPG classifier still names the gait: "angle" at K = 0.01 scored
+  47.5 N s (open loop 40), "load" at best 42.5 (K = 0.03), "load_antagonist" 40 (K = 0.01);
+  at K = 0.1 the load forms turn the network's walk and run into a skip.
 Hopf (Tegotae, Owaki & Ishiguro 2013/2017: each extensor oscillator's phase is pushed by its
 leg's load). With the phase theta_i = atan2(y_i, x_i) (the burst, y > 0, is theta in (0, pi)):
     dtheta_{2+l}/dt += K n_l cos(theta_{2+l})

@@ -7,8 +7,10 @@ gaits comes from the CPG's activations, tick by tick.
 
 Per control tick (every ``control_every`` physics steps; ctrl held in between):
 
-1. CPG. The network has no feedback, so it is integrated ahead from its initial state at
-   t = 0 (when the body starts) and sampled at the tick: t_model = units_per_s * t_s, with
+1. CPG. Open loop (the default, as in the paper) the network is integrated ahead from its
+   initial state at t = 0 (when the body starts) and sampled at the tick; closed loop
+   (``loop``, :mod:`cpg.feedback`) it is stepped one tick at a time with the body's sensors;
+   either way t_model = units_per_s * t_s, with
    the network's fixed time unit (:mod:`cpg.network`). The schedule holds the raw outputs v
    and the activations a = network.activation(v) in [0, 1] of the cells LF, RF, LE, RE.
    Per leg i (j the other leg): flexor f_i = a_iF, extensor e_i = a_iE,

@@ -122,9 +122,17 @@ def picture(results: list[dict], title: str, path) -> None:
         a1.plot(r["phases"], r["dphi"], "o-", color=color, label=lab)
         y = [np.nan if x is None else x for x in r["relock_cycles"]]
         a2.plot(r["phases"], y, "o-", color=color, label=lab)
+        fell = [p for p, f in zip(r["phases"], r.get("fell", [])) if f]
+        unlocked = [p for p, x, f in zip(r["phases"], r["relock_cycles"], r.get("fell", []))
+                    if x is None and not f]
+        a2.plot(fell, [-0.6] * len(fell), "x", color=color, ms=9,
+                label="fell" if fell else None)
+        a2.plot(unlocked, [-0.6] * len(unlocked), "^", color=color, mfc="none", ms=8,
+                label="not re-locked in the window" if unlocked else None)
     a1.axhline(0, color="k", lw=0.6)
     a1.set_ylabel("CPG phase shift (cycles, + advanced)")
     a2.set_ylabel("cycles to re-lock body and CPG")
+    a2.legend(fontsize=7)
     a2.set_xlabel("phase of the push in the stride (0: left touchdown)")
     a1.set_title(title, fontsize=10)
     a1.legend(fontsize=8)

@@ -30,7 +30,7 @@ from pathlib import Path
 CANDIDATES = {
     "ml": [("load", k) for k in (0.01, 0.03, 0.1)]
           + [("load_antagonist", k) for k in (0.01, 0.03, 0.1)]
-          + [("angle", k) for k in (0.01, 0.03, 0.1)],
+          + [("angle", k) for k in (0.01, 0.03, 0.05, 0.1)],
     "hopf": [("tegotae", k) for k in (0.5, 1.0, 2.0, 5.0)],
     "matsuoka": [("taga", k) for k in (0.03, 0.1, 0.3)],
 }
