@@ -25,12 +25,16 @@ chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuok
   "load": dv_{2+l}/dt += K (n_l - 1/2), the extensor depolarised by its leg's load (load
     feedback from the extensors, Duysens & Pearson); zero for a leg carrying half the body,
     so standing on both feet leaves the paper's rhythm;
-  "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2).
+  "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2);
+  "reset": a touchdown pulse (phase resetting, Aoi & Tsuchiya): dv_{2+l}/dt += K p_l,
+    dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0.
   scripts/feedback_choice.py scored every form at K = 0.01, 0.03, 0.1 by the push envelope
   of the walk and the run on tuning conditions (CPG seed 1000, pushes after 5.5 s), keeping
   only gains at which the CPG classifier still names the gait: "angle" at K = 0.01 scored
-  47.5 N s (open loop 40), "load" at best 42.5 (K = 0.03), "load_antagonist" 40 (K = 0.01);
-  at K = 0.1 the load forms turn the network's walk and run into a skip.
+  47.5 N s (open loop 40), "load" at best 42.5 (K = 0.03), "load_antagonist" 40 (K = 0.01),
+  "reset" 40 at K = 0.05 (as open loop); at K = 0.1 the load forms and the reset turn the
+  network's walk (and the load forms its run) into a skip (cpg/feedback_gains.json holds every
+  candidate's numbers).
 Hopf (Tegotae, Owaki & Ishiguro 2013/2017: each extensor oscillator's phase is pushed by its
 leg's load). With the phase theta_i = atan2(y_i, x_i) (the burst, y > 0, is theta in (0, pi)):
     dtheta_{2+l}/dt += K n_l cos(theta_{2+l})
@@ -75,7 +79,17 @@ KIND_ML, KIND_HOPF, KIND_MATSUOKA = 0, 1, 2
 KIND_ML_ANTAGONIST = 3
 # ... and the Morris-Lecar cells with Taga's contact-gated thigh angle (the Matsuoka form).
 KIND_ML_ANGLE = 4
-ML_FORMS = {"load": KIND_ML, "load_antagonist": KIND_ML_ANTAGONIST, "angle": KIND_ML_ANGLE}
+# ... and a touchdown pulse (phase resetting, Aoi & Tsuchiya): for RESET_S after leg l's foot
+# lands, its extensor receives +K and its flexor -K.
+KIND_ML_RESET = 5
+ML_FORMS = {"load": KIND_ML, "load_antagonist": KIND_ML_ANTAGONIST, "angle": KIND_ML_ANGLE,
+            "reset": KIND_ML_RESET}
+ML_CODES = (KIND_ML, KIND_ML_ANTAGONIST, KIND_ML_ANGLE, KIND_ML_RESET)
+RESET_S = 0.05  # s: length of the touchdown pulse
+# The sensor vector the controller fills (envs.control_kernel.body_sensors): n_L, n_R, q_L,
+# q_R, the touchdown pulses p_L, p_R (1 during RESET_S after a landing), then the detector's
+# memory (time left of each pulse, each foot's last contact state).
+N_SENSORS = 10
 LOAD_CONTACT = 0.05  # body weights: a foot carrying more is on the ground (gate c_l)
 THETA_REF = 0.3  # rad: Taga's thigh-angle scale for the Matsuoka pathway
 MAX_GAIN = {"ml": 1.0, "hopf": 50.0, "matsuoka": 5.0}  # beyond these the network is swamped
@@ -127,6 +141,7 @@ class LoopNetwork:
     n_sub: int
     gain: float
     noise: np.ndarray  # (steps, 12) or (0, 12)
+    tick_s: float  # seconds per tick
 
 
 def loop_network(network, K: float, tick_s: float, seconds: float,
@@ -152,7 +167,8 @@ def loop_network(network, K: float, tick_s: float, seconds: float,
         noise = spec["L"] * rng.standard_normal((n_steps + 1, 1, 12))[:, 0, :]
     return LoopNetwork(code, np.ascontiguousarray(P, dtype=float),
                        np.array(network.y0, dtype=float), float(act_c), float(act_w),
-                       unit / n_sub, n_sub, float(K), np.ascontiguousarray(noise))
+                       unit / n_sub, n_sub, float(K), np.ascontiguousarray(noise),
+                       float(tick_s))
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -177,6 +193,9 @@ def inputs(code, K, y, sensors, inp):
         elif code == KIND_ML_ANTAGONIST:
             inp[2 + leg] = K * (n - 0.5)
             inp[leg] = -K * (n - 0.5)
+        elif code == KIND_ML_RESET:
+            inp[2 + leg] = K * sensors[4 + leg]
+            inp[leg] = -K * sensors[4 + leg]
         elif code == KIND_HOPF:
             x, v = y[2 + leg], y[6 + leg]
             r = math.sqrt(x * x + v * v) + 1e-12
@@ -241,7 +260,8 @@ def advance(code, P, y, K, sensors, n_sub, h, noise, step0, inp, scratch):
     inputs(code, K, y, sensors, inp)
     D = y.shape[0]
     k1, k2, k3, k4, tmp = scratch[0, :D], scratch[1, :D], scratch[2, :D], scratch[3, :D], scratch[4, :D]
-    if code == KIND_ML or code == KIND_ML_ANTAGONIST or code == KIND_ML_ANGLE:
+    if code == KIND_ML or code == KIND_ML_ANTAGONIST or code == KIND_ML_ANGLE or \
+            code == KIND_ML_RESET:
         colsum = np.zeros(4)
         for j in range(4):
             for i in range(4):
@@ -315,18 +335,18 @@ def outputs(code, y, act_centre, act_width, v, a):
 
 
 def run_open(net: LoopNetwork, n_ticks: int, sensors: np.ndarray | None = None) -> np.ndarray:
-    """The stepped network alone for n_ticks ticks, sensors (n_ticks, 4) held per tick (zeros
-    by default); outputs v (n_ticks + 1, 4) at the ticks. For tests and phase response."""
+    """The stepped network alone for n_ticks ticks, sensors (n_ticks, <= N_SENSORS) held per
+    tick (zeros by default; missing columns zero); outputs v (n_ticks + 1, 4) at the ticks."""
     y = net.y.copy()
     v, a = np.empty(4), np.empty(4)
     out = np.empty((n_ticks + 1, 4))
     inp, scratch = np.zeros(4), np.zeros((6, 24))
     outputs(net.code, y, net.act_centre, net.act_width, v, a)
     out[0] = v
-    s = np.zeros(4)
+    s = np.zeros(N_SENSORS)
     for k in range(n_ticks):
         if sensors is not None:
-            s = np.ascontiguousarray(sensors[k], dtype=float)
+            s[:len(sensors[k])] = sensors[k]
         if not advance(net.code, net.P, y, net.gain, s, net.n_sub, net.h, net.noise,
                        k * net.n_sub, inp, scratch):
             out[k + 1:] = np.nan

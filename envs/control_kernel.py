@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
-from cpg.feedback import LOAD_CONTACT
+from cpg.feedback import LOAD_CONTACT, RESET_S
 from cpg.feedback import advance as fb_advance
 from cpg.feedback import inputs as fb_inputs
 from cpg.feedback import outputs as fb_outputs
@@ -366,20 +366,29 @@ NO_FB = np.zeros(4)  # the feedback row of an open-loop rollout
 
 
 @njit(cache=True)
-def body_sensors(qpos, sens, ix, weight_n, out):
-    """The sensors the CPG's feedback reads (cpg.feedback): out = (n_L, n_R, q_L, q_R), the
-    feet's normal loads in body weights (weight_n newtons) and the contact-gated thigh angles
-    (rad from the vertical, > 0 forward)."""
+def body_sensors(qpos, sens, ix, weight_n, tick_s, out):
+    """The sensors the CPG's feedback reads (cpg.feedback, N_SENSORS values): the feet's
+    normal loads in body weights (weight_n newtons), the contact-gated thigh angles (rad from
+    the vertical, > 0 forward), the touchdown pulses (1 for RESET_S after a foot lands, the
+    load crossing LOAD_CONTACT upwards), then the detector's memory (time left of each pulse,
+    each foot's contact at the last tick). Called once per tick of ``tick_s`` seconds."""
     for i in range(2):
         n = abs(sens[ix[IX_FORCE + i]]) / weight_n
         out[i] = n
-        gate = 1.0 if n > LOAD_CONTACT else 0.0
+        on = n > LOAD_CONTACT
+        gate = 1.0 if on else 0.0
         out[2 + i] = gate * (qpos[ix[IX_HIP_Q + i]] + qpos[ix[IX_ROOTY_Q]])
+        left = out[6 + i] - tick_s
+        if on and out[8 + i] < 0.5:  # a landing
+            left = RESET_S
+        out[6 + i] = max(left, 0.0)
+        out[4 + i] = 1.0 if out[6 + i] > 1e-9 else 0.0
+        out[8 + i] = gate
 
 
 @njit(cache=True)
 def step_closed(advance_first, code, NP, y, K, n_sub, h, noise, step0, act_c, act_w, weight_n,
-                sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix, ctrl, v, a):
+                tick_s, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix, ctrl, v, a):
     """The closed-loop controller at one tick (cpg.feedback): when ``advance_first``, advance
     the network over the last tick with the sensors held since then (``sensors``; ``step0``
     is the tick's first network step, for the Matsuoka noise); then read this tick's sensors
@@ -389,7 +398,7 @@ def step_closed(advance_first, code, NP, y, K, n_sub, h, noise, step0, act_c, ac
         if not fb_advance(code, NP, y, K, sensors, n_sub, h, noise, step0, scratch[5, :4],
                           scratch):
             return False
-    body_sensors(qpos, sens, ix, weight_n, sensors)
+    body_sensors(qpos, sens, ix, weight_n, tick_s, sensors)
     fb_inputs(code, K, y, sensors, fb)
     fb_outputs(code, y, act_c, act_w, v, a)
     control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, ctrl)
@@ -397,8 +406,8 @@ def step_closed(advance_first, code, NP, y, K, n_sub, h, noise, step0, act_c, ac
 
 
 @njit(cache=True)
-def tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w, weight_n, sensors, fb,
-                scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
+def tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w, weight_n, tick_s,
+                sensors, fb, scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
                 fall_height, fall_pitch):
     """One closed-loop control tick of a rollout: record row k - 1 (with the CPG outputs and
     feedback terms of tick k - 1), then :func:`step_closed`. Returns the status of row k - 1,
@@ -410,7 +419,7 @@ def tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w, weight_n,
         if status == 2:
             return status
     if not step_closed(k > 0, code, NP, y, K, n_sub, h, noise, (k - 1) * n_sub, act_c, act_w,
-                       weight_n, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix,
+                       weight_n, tick_s, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix,
                        ctrl, v, a):
         return 2
     return status

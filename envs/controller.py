@@ -327,7 +327,9 @@ class CPGController:
         self.last_a = np.zeros(4)
         # closed loop: the sensors held over a tick, the feedback terms, work space
         self.weight_n = float(model.body_subtreemass[0] * np.linalg.norm(model.opt.gravity))
-        self.sensors = np.zeros(4)
+        from cpg.feedback import N_SENSORS
+
+        self.sensors = np.zeros(N_SENSORS)
         self.fb = np.zeros(4)
         self.scratch = np.zeros((6, 24))
         self.ticks = 0
@@ -352,7 +354,7 @@ class CPGController:
         L = self.loop
         ok = kernel.step_closed(self.ticks > 0, L.code, L.P, L.y, L.gain, L.n_sub, L.h, L.noise,
                                 (self.ticks - 1) * L.n_sub, L.act_centre, L.act_width,
-                                self.weight_n, self.sensors, self.fb, self.scratch, t_s, self.P,
+                                self.weight_n, L.tick_s, self.sensors, self.fb, self.scratch, t_s, self.P,
                                 self.S, qpos, qvel, sens, xpos, self.ix, self.u, self.last_v,
                                 self.last_a)
         self.ticks += 1

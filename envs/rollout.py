@@ -136,7 +136,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     if K > 0:
         L = ctrl.loop
         loop_args = (L.code, L.P, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
-                     ctrl.weight_n, ctrl.sensors, ctrl.fb, ctrl.scratch)
+                     ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb, ctrl.scratch)
 
         def tick(k):
             return kernel.tick_closed(k, d.time, *loop_args, P, S, qpos, qvel, sens, xpos, act,
@@ -208,7 +208,7 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_
             k_next, status = run_ticks_closed(
                 m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY, d.time, dt, L.code,
                 L.P, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
-                ctrl.weight_n, ctrl.sensors, ctrl.fb, ctrl.scratch, ctrl.P, ctrl.S, *args)
+                ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb, ctrl.scratch, ctrl.P, ctrl.S, *args)
         if bad_qacc.number:  # somewhere in this chunk: keep the rows recorded before it
             return max(k - 1, 0), fell, f"physics became unstable at t={d.time:.3f} s"
         if status == 2:  # row k_next - 2 is not finite

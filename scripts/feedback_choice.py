@@ -1,8 +1,8 @@
 """Choose each network's feedback pathway and recommended gain by measurement.
 
 Candidates: the Morris-Lecar forms of cpg.feedback (load into the extensors, load into
-extensors and flexors, Taga's gated thigh angle), Hopf Tegotae, Matsuoka Taga; each at a few
-gains K. For each candidate and each alternating preset of the network (walk and run; the
+extensors and flexors, Taga's gated thigh angle, a touchdown pulse), Hopf Tegotae, Matsuoka
+Taga; each at a few gains K. For each candidate and each alternating preset of the network (walk and run; the
 Matsuoka network has only its walk), on **tuning conditions only** (CPG seed 1000, pushes in
 the stride after 5.5 s; the reported envelope of ``cpgbiped robustness`` uses the preset's
 own state and pushes after 6 s, and the tests CPG seeds 10-19):
@@ -30,7 +30,8 @@ from pathlib import Path
 CANDIDATES = {
     "ml": [("load", k) for k in (0.01, 0.03, 0.1)]
           + [("load_antagonist", k) for k in (0.01, 0.03, 0.1)]
-          + [("angle", k) for k in (0.01, 0.03, 0.05, 0.1)],
+          + [("angle", k) for k in (0.01, 0.03, 0.05, 0.1)]
+          + [("reset", k) for k in (0.05, 0.1, 0.2)],
     "hopf": [("tegotae", k) for k in (0.5, 1.0, 2.0, 5.0)],
     "matsuoka": [("taga", k) for k in (0.03, 0.1, 0.3)],
 }

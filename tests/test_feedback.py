@@ -229,3 +229,25 @@ def test_the_cpg_classifier_names_each_preset_from_the_closed_loop_cells(preset)
 
     v = validate(build("ml", preset), None, 20.0, feedback=RECOMMENDED["ml"])
     assert v.cpg_gait == preset
+
+
+def test_the_touchdown_pulse_follows_each_landing_for_fifty_milliseconds():
+    """Reset form: the extensor receives K (the flexor -K) for RESET_S after each landing,
+    the landings taken here from the recorded loads (crossing LOAD_CONTACT upwards)."""
+    from cpg.feedback import RESET_S
+    from envs.biped import body_constants
+
+    K = 0.05
+    rec = rollout(build("ml", "walk"), 8.0, poses=False, feedback=K, feedback_form="reset")
+    on = rec.force / (body_constants()[1] * 9.81) > LOAD_CONTACT
+    for leg in range(2):
+        landings = np.nonzero(on[1:, leg] & ~on[:-1, leg])[0] + 1
+        pulse = rec.feedback[1:, 2 + leg] > 0  # row r's input: the sensors of row r - 1
+        assert len(landings) >= 6 and pulse[landings[landings < len(pulse)]].all()
+        n = int(np.ceil(RESET_S / rec.dt - 1e-9))  # ticks of a pulse (the last one partial)
+        since = np.full(len(pulse), 10**9)  # ticks since the last landing
+        for j in range(len(pulse)):
+            since[j] = 0 if j in set(landings) else (since[j - 1] + 1 if j else 10**9)
+        assert np.array_equal(pulse, since < n)
+        assert np.allclose(rec.feedback[1:, 2 + leg][pulse], K)
+        assert np.array_equal(rec.feedback[:, leg], -rec.feedback[:, 2 + leg])
