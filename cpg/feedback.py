@@ -142,13 +142,26 @@ class LoopNetwork:
     gain: float
     noise: np.ndarray  # (steps, 12) or (0, 12)
     tick_s: float  # seconds per tick
+    # A parameter change (Morris-Lecar): the parameters at alpha = 0 and 1 (rows of P_ab) and
+    # the knots (time s, alpha) of the schedule (cpg.integrate.Schedule); (0, 2) without one.
+    P_ab: np.ndarray = None
+    knots: np.ndarray = None
+
+    def __post_init__(self):
+        if self.P_ab is None:
+            self.P_ab = np.stack([self.P, self.P])
+        if self.knots is None:
+            self.knots = np.zeros((0, 2))
 
 
 def loop_network(network, K: float, tick_s: float, seconds: float,
-                 form: str | None = None) -> LoopNetwork:
+                 form: str | None = None, to=None, change=None) -> LoopNetwork:
     """The network ready to be stepped in a closed loop of ``tick_s``-second ticks for
     ``seconds`` (at most). ``form`` (Morris-Lecar only, one of :data:`ML_FORMS`): a pathway
-    other than the chosen one, for the measurement that chose it."""
+    other than the chosen one, for the measurement that chose it. ``to``, ``change``
+    (Morris-Lecar only): the parameters move linearly towards ``to``'s along the schedule
+    ``change`` (knot times in seconds), held over each tick at their value at its start, as
+    the open-loop integration holds them over each step."""
     spec = network.loop_spec()
     code, P, act_c, act_w = spec["code"], spec["P"], spec["act_centre"], spec["act_width"]
     if form is None and code == KIND_ML:
@@ -165,10 +178,37 @@ def loop_network(network, K: float, tick_s: float, seconds: float,
         n_steps = int(round((seconds + 0.1) / network.dt))
         rng = np.random.default_rng(spec["seed"])  # the open-loop sequence (cpg.matsuoka)
         noise = spec["L"] * rng.standard_normal((n_steps + 1, 1, 12))[:, 0, :]
-    return LoopNetwork(code, np.ascontiguousarray(P, dtype=float),
-                       np.array(network.y0, dtype=float), float(act_c), float(act_w),
-                       unit / n_sub, n_sub, float(K), np.ascontiguousarray(noise),
-                       float(tick_s))
+    P = np.ascontiguousarray(P, dtype=float)
+    P_ab = knots = None
+    if to is not None:
+        if code not in ML_CODES or to.kind != "ml":
+            raise InputError("feedback through a parameter change is built for the Morris-Lecar "
+                             "network only")
+        P_ab = np.ascontiguousarray(np.stack([P, to.loop_spec()["P"]]), dtype=float)
+        knots = np.ascontiguousarray(np.column_stack([change.t, change.alpha]), dtype=float)
+    return LoopNetwork(code, P.copy(), np.array(network.y0, dtype=float), float(act_c),
+                       float(act_w), unit / n_sub, n_sub, float(K), np.ascontiguousarray(noise),
+                       float(tick_s), P_ab, knots)
+
+
+@njit(cache=True)
+def blend_at(t_s, P_ab, knots, P):
+    """P = P_ab[0] + alpha(t_s) (P_ab[1] - P_ab[0]), alpha piecewise linear through the knots
+    (time s, alpha), held outside them; at a repeated knot (a step) the later value."""
+    K = knots.shape[0]
+    if K == 0:
+        return
+    if t_s < knots[0, 0]:
+        al = knots[0, 1]
+    else:
+        al = knots[K - 1, 1]
+        for q in range(1, K):
+            if t_s < knots[q, 0]:
+                t0, t1 = knots[q - 1, 0], knots[q, 0]
+                al = knots[q - 1, 1] + (knots[q, 1] - knots[q - 1, 1]) * (t_s - t0) / (t1 - t0)
+                break
+    for q in range(P.shape[0]):
+        P[q] = P_ab[0, q] + al * (P_ab[1, q] - P_ab[0, q])
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -347,6 +387,7 @@ def run_open(net: LoopNetwork, n_ticks: int, sensors: np.ndarray | None = None) 
     for k in range(n_ticks):
         if sensors is not None:
             s[:len(sensors[k])] = sensors[k]
+        blend_at(k * net.tick_s, net.P_ab, net.knots, net.P)
         if not advance(net.code, net.P, y, net.gain, s, net.n_sub, net.h, net.noise,
                        k * net.n_sub, inp, scratch):
             out[k + 1:] = np.nan

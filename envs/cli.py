@@ -654,6 +654,96 @@ def cmd_phase_response(a) -> int:
     return 0
 
 
+def cmd_transition(a) -> int:
+    from cpg import io
+    from envs.render import check_backend, check_video_size, gait_diagram, render_video
+    from envs.transition import check_transition, transition
+
+    seconds = a.seconds if a.seconds is not None else a.at + a.ramp + 12.0
+    check_transition(a.network, getattr(a, "from"), a.to, a.at, a.ramp, seconds)
+    K = feedback_gain(a, a.network)
+    if a.out:
+        check_video_size(a.width, a.height, a.fps, seconds)
+        out_file(a.out, "--out", ".mp4")
+        check_backend()
+    out_file(a.rrd, "--rrd", ".rrd")
+    src, dst = getattr(a, "from"), a.to
+    res, rec, net, to = transition(a.network, src, dst, a.at, a.ramp, seconds, K,
+                                   poses=bool(a.out or a.rrd))
+    label = (f"{a.network} {src} -> {dst} at {a.at:g} s" + (f" over {a.ramp:g} s" if a.ramp else "")
+             + (f", feedback K = {K:g}" if K else ""))
+    marks = [(a.at, "change")] + ([(a.at + a.ramp, "end of ramp")] if a.ramp else [])
+    written = []
+    if a.out:
+        path = render_video(rec, a.out, a.fps, a.width, a.height, seconds,
+                            marks=[m[0] for m in marks])
+        stem = os.path.splitext(a.out)[0]
+        gait_diagram(rec, stem + "_gait.png", None, label, window_s=None, marks=marks)
+        written += [str(path), stem + "_gait.png"]
+    if a.rrd:
+        from envs.record import write_rrd
+
+        write_rrd(a.rrd, {f"{src}_to_{dst}": (rec, res)}, marks={f"{src}_to_{dst}": marks})
+        written.append(a.rrd)
+    if a.json:
+        print(io.to_json(res))
+    else:
+        b, f = res["before"], res["after"]
+        print(label)
+        print(f"  before ({b['start_s']:g}-{b['end_s']:g} s): physical {b['physical_gait']}, "
+              f"CPG {b['cpg_gait']}, {b['speed_mps']:.2f} m/s")
+        print(f"  after  ({f['start_s']:.2f}-{f['end_s']:g} s): physical {f['physical_gait']}, "
+              f"CPG {f['cpg_gait']}, {f['speed_mps']:.2f} m/s")
+        print(f"  sliding windows of {3} CPG cycles: "
+              + " ".join(w["physical_gait"] for w in res["windows"]))
+        print(f"  fell: {'at %.2f s' % res['fell_at_s'] if res['fell'] else 'no'}; switched to "
+              f"{dst}: " + (f"after {res['cycles_to_switch']} CPG cycles"
+                            if res["cycles_to_switch"] is not None else "no"))
+        if written:
+            print("wrote " + ", ".join(written))
+    return 0
+
+
+def cmd_sweep(a) -> int:
+    from cpg import io
+    from envs.sweep import check_pair, picture, sweep
+
+    check_pair(a.pair)
+    out_dir(a.out)
+    K = feedback_gain(a, a.network)
+    if a.video:
+        from envs.render import check_backend
+
+        check_backend()
+    res, rec = sweep(a.pair, a.ramp_seconds, a.network, K, poses=a.video)
+    stem = os.path.join(a.out, f"sweep_{a.network}_{a.pair}" + (f"_K{K:g}" if K else ""))
+    io.write_json(stem + ".json", res)
+    picture(res, stem + ".png")
+    written = [stem + ".json", stem + ".png"]
+    if a.video:
+        from envs.render import render_video
+
+        sch_t = [4.0, 4.0 + a.ramp_seconds, 8.0 + a.ramp_seconds, 8.0 + 2 * a.ramp_seconds]
+        render_video(rec, stem + ".mp4", 30.0, 640, 480, float(rec.t[-1]), marks=sch_t)
+        written.append(stem + ".mp4")
+    if a.json:
+        print(io.to_json(res))
+    else:
+        f = lambda p: "no switch" if p is None else (  # noqa: E731
+            f"d = {p['drive']:.2f} at {p['time_s']:.1f} s, {p['speed_mps']:.2f} m/s, "
+            f"Fr {p['froude']:.3f}")
+        print(f"{a.network} {a.pair} drive sweep (ramps of {a.ramp_seconds:g} s"
+              + (f", feedback K = {K:g}" if K else "") + "):")
+        print(f"  switch up to {res['to']}: {f(res['switch_up'])}")
+        print(f"  switch down from {res['to']}: {f(res['switch_down'])}")
+        hy = res["hysteresis_drive"]
+        print("  hysteresis: " + ("not measured (a switch is missing)" if hy is None
+                                  else f"{hy:+.2f} in drive"))
+        print(f"  fell: {'at %.1f s' % res['fell_at_s'] if res['fell'] else 'no'}")
+        print("wrote " + ", ".join(written))
+    return 0
+
+
 # --------------------------------------------------------------------------------------- demo
 def cmd_demo(a) -> int:
     from envs.demo import run_demo
@@ -809,6 +899,51 @@ def build_parser() -> argparse.ArgumentParser:
                     help="push impulse, N s forwards (negative: backwards; default 5)")
     sp.add_argument("--out", default="out/robustness", metavar="DIR",
                     help="folder for the JSON and the picture (default out/robustness)")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+
+    sp = add("transition", cmd_transition, "change the network's parameters in mid-run", """\
+        The network starts as preset --from (Table 3 state) and its parameters move to
+        --to's at --at s (simulation time from the start, settling included): a step, or a
+        linear ramp over --ramp s. The CPG's state carries across; the controller is not
+        told. Metrics before the change, and after the physical gait has settled (sliding
+        windows of 3 CPG cycles; cycles_to_switch counts the CPG cycles from the change until
+        the settled gait is --to). --out writes a video whose CPG strip marks the change,
+        with FILE_gait.png (the whole rollout's gait diagram, the change marked); --rrd a
+        rerun recording with the change as an event.""")
+    sp.add_argument("--from", required=True, metavar="A", help="the starting gait (preset)")
+    sp.add_argument("--to", required=True, metavar="B", help="the gait (preset) changed to")
+    sp.add_argument("--at", type=finite_arg, default=8.0, metavar="T_S",
+                    help="time of the change, s from the start (default 8)")
+    sp.add_argument("--ramp", type=finite_arg, default=0.0, metavar="R_S",
+                    help="ramp length, s (default 0: a step)")
+    sp.add_argument("--seconds", type=seconds_arg, default=None,
+                    help="whole rollout, s (default: the change's end + 12 s)")
+    sp.add_argument("--network", default="ml", choices=("ml", "hopf"))
+    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
+                    metavar="K", help=FEEDBACK_HELP + " (Morris-Lecar)")
+    sp.add_argument("--width", type=count_arg(1), default=640)
+    sp.add_argument("--height", type=count_arg(1), default=480)
+    sp.add_argument("--fps", type=positive_arg, default=30.0)
+    sp.add_argument("--out", default=None, metavar="FILE.mp4", help="also render a video")
+    sp.add_argument("--rrd", default=None, metavar="FILE.rrd", help="also write a rerun recording")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+
+    sp = add("sweep", cmd_sweep, "a slow drive sweep walk<->run or jump<->hop, with hysteresis", """\
+        One drive d in [0, 1] moves every parameter of the network linearly from preset A
+        (d = 0) to preset B (d = 1): 0 until 4 s, a ramp up over --ramp-seconds, 4 s held, a
+        ramp down, 4 s at 0; one rollout. The physical gait is named in sliding 3 s windows;
+        the drive, speed and Froude number where it switches to B on the way up and leaves
+        it on the way down, and their difference (hysteresis). Writes
+        --out/sweep_<network>_<pair>.json and .png (speed and gait against the drive), and
+        with --video an mp4 whose CPG strip marks the ramps' corners.""")
+    sp.add_argument("--pair", default="walk-run", help="walk-run or jump-hop (default walk-run)")
+    sp.add_argument("--ramp-seconds", type=finite_arg, default=40.0, metavar="R",
+                    help="length of each ramp, s in [5, 200] (default 40)")
+    sp.add_argument("--network", default="ml", choices=("ml", "hopf"))
+    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
+                    metavar="K", help=FEEDBACK_HELP + " (Morris-Lecar)")
+    sp.add_argument("--video", action="store_true", help="also render the sweep to mp4")
+    sp.add_argument("--out", default="out/sweep", metavar="DIR")
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("check-pareto", cmd_check_pareto, "run an optimiser result's Pareto points in physics",

@@ -19,6 +19,7 @@ from numba import njit
 
 from cpg.feedback import LOAD_CONTACT, RESET_S
 from cpg.feedback import advance as fb_advance
+from cpg.feedback import blend_at as fb_blend_at
 from cpg.feedback import inputs as fb_inputs
 from cpg.feedback import outputs as fb_outputs
 
@@ -387,14 +388,18 @@ def body_sensors(qpos, sens, ix, weight_n, tick_s, out):
 
 
 @njit(cache=True)
-def step_closed(advance_first, code, NP, y, K, n_sub, h, noise, step0, act_c, act_w, weight_n,
-                tick_s, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix, ctrl, v, a):
+def step_closed(advance_first, code, NP, P_ab, knots, y, K, n_sub, h, noise, step0, act_c, act_w,
+                weight_n, tick_s, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix,
+                ctrl, v, a):
     """The closed-loop controller at one tick (cpg.feedback): when ``advance_first``, advance
     the network over the last tick with the sensors held since then (``sensors``; ``step0``
     is the tick's first network step, for the Matsuoka noise); then read this tick's sensors
     into ``sensors``, their feedback terms into ``fb``, the CPG's outputs into v and a, and the
-    controls into ``ctrl``. Returns False when the network's state left its range."""
+    controls into ``ctrl``. The network's parameters ``NP`` move along ``knots`` between the
+    rows of ``P_ab`` (a parameter change; held over the tick at their value at its start).
+    Returns False when the network's state left its range."""
     if advance_first:
+        fb_blend_at(t_s - tick_s, P_ab, knots, NP)
         if not fb_advance(code, NP, y, K, sensors, n_sub, h, noise, step0, scratch[5, :4],
                           scratch):
             return False
@@ -406,8 +411,8 @@ def step_closed(advance_first, code, NP, y, K, n_sub, h, noise, step0, act_c, ac
 
 
 @njit(cache=True)
-def tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w, weight_n, tick_s,
-                sensors, fb, scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
+def tick_closed(k, t_s, code, NP, P_ab, knots, y, K, n_sub, h, noise, act_c, act_w, weight_n,
+                tick_s, sensors, fb, scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
                 fall_height, fall_pitch):
     """One closed-loop control tick of a rollout: record row k - 1 (with the CPG outputs and
     feedback terms of tick k - 1), then :func:`step_closed`. Returns the status of row k - 1,
@@ -418,8 +423,8 @@ def tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w, weight_n,
                         rec, fall_height, fall_pitch)
         if status == 2:
             return status
-    if not step_closed(k > 0, code, NP, y, K, n_sub, h, noise, (k - 1) * n_sub, act_c, act_w,
-                       weight_n, tick_s, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix,
+    if not step_closed(k > 0, code, NP, P_ab, knots, y, K, n_sub, h, noise, (k - 1) * n_sub,
+                       act_c, act_w, weight_n, tick_s, sensors, fb, scratch, t_s, P, S, qpos, qvel, sens, xpos, ix,
                        ctrl, v, a):
         return 2
     return status

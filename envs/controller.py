@@ -352,11 +352,11 @@ class CPGController:
                            qpos, qvel, sens, xpos, self.ix, self.u, self.last_v, self.last_a)
             return self.u
         L = self.loop
-        ok = kernel.step_closed(self.ticks > 0, L.code, L.P, L.y, L.gain, L.n_sub, L.h, L.noise,
-                                (self.ticks - 1) * L.n_sub, L.act_centre, L.act_width,
-                                self.weight_n, L.tick_s, self.sensors, self.fb, self.scratch, t_s, self.P,
-                                self.S, qpos, qvel, sens, xpos, self.ix, self.u, self.last_v,
-                                self.last_a)
+        ok = kernel.step_closed(self.ticks > 0, L.code, L.P, L.P_ab, L.knots, L.y, L.gain,
+                                L.n_sub, L.h, L.noise, (self.ticks - 1) * L.n_sub, L.act_centre,
+                                L.act_width, self.weight_n, L.tick_s, self.sensors, self.fb,
+                                self.scratch, t_s, self.P, self.S, qpos, qvel, sens, xpos,
+                                self.ix, self.u, self.last_v, self.last_a)
         self.ticks += 1
         if not ok:
             raise InputError("the network's state left its range under feedback: lower the gain")

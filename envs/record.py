@@ -198,8 +198,10 @@ def blueprint(rollouts: dict, videos: dict | None = None):
     return rrb.Blueprint(rrb.Tabs(*tabs) if len(tabs) > 1 else tabs[0], collapse_panels=True)
 
 
-def write_rrd(path: str | Path, rollouts: dict, videos: dict | None = None) -> Path:
-    """One .rrd holding every rollout: ``rollouts`` maps name -> (Recording, metrics)."""
+def write_rrd(path: str | Path, rollouts: dict, videos: dict | None = None,
+              marks: dict | None = None) -> Path:
+    """One .rrd holding every rollout: ``rollouts`` maps name -> (Recording, metrics);
+    ``marks``: name -> [(time s, label)], logged as events ``/<name>/events/<label>``."""
     import rerun as rr
 
     path = Path(path)
@@ -210,6 +212,9 @@ def write_rrd(path: str | Path, rollouts: dict, videos: dict | None = None) -> P
         rs.save(str(tmp))
         for name, (rec, metrics) in rollouts.items():
             log_rollout(rs, name, rec, metrics, (videos or {}).get(name))
+            for tm, label in (marks or {}).get(name, []):
+                _columns(rs, f"/{name}/events/{label.replace(' ', '_')}", np.array([tm]),
+                         np.ones(1))
         rs.send_blueprint(blueprint(rollouts, videos))
         rs.flush()
         rs.disconnect()

@@ -156,11 +156,19 @@ def frame_indices(t: np.ndarray, fps: float, seconds: float) -> np.ndarray:
     return np.clip(np.searchsorted(t, times + 1e-9), 0, len(t) - 1)
 
 
-def _signal_strip(rec, k: int, width: int, height: int) -> np.ndarray:
-    """A small plot of the four CPG outputs (last 2 s up to sample k) as an RGB image."""
+def _signal_strip(rec, k: int, width: int, height: int, marks=()) -> np.ndarray:
+    """A small plot of the four CPG outputs (last 2 s up to sample k) as an RGB image; the
+    times in ``marks`` (s) that fall in the window are drawn as black vertical lines, and
+    while the last mark is under 2 s old the strip's border is black."""
     img = np.full((height, width, 3), 255, np.uint8)
     lo = max(0, k - int(2.0 / rec.dt))
     seg = rec.cpg_v[lo:k + 1]
+    n_win = int(2.0 / rec.dt) + 1
+    for tm in marks:
+        j = int(round((tm - rec.t[0]) / rec.dt))
+        if lo <= j <= k:
+            x = int(round((width - 1) * (n_win - 1 - (k - j)) / (n_win - 1)))
+            img[:, max(0, x - 1):x + 2] = 0
     if len(seg) < 2:
         return img
     colors = [(31, 119, 180), (214, 39, 40), (23, 190, 207), (255, 127, 14)]
@@ -177,9 +185,11 @@ def _signal_strip(rec, k: int, width: int, height: int) -> np.ndarray:
 
 
 def render_video(rec, path: str | Path, fps: float = 30.0, width: int = 640, height: int = 480,
-                 seconds: float | None = None, signals: bool = True, fancy: bool = False) -> Path:
+                 seconds: float | None = None, signals: bool = True, fancy: bool = False,
+                 marks=()) -> Path:
     """Write an mp4 of a recording (its joint positions), streamed
-    frame by frame to a temporary file that is renamed when complete."""
+    frame by frame to a temporary file that is renamed when complete. ``marks``: times (s)
+    drawn as vertical lines in the CPG strip (a parameter change)."""
     seconds = float(rec.t[-1]) if seconds is None else seconds
     check_video_size(width, height, fps, seconds)
     if rec.qpos.size == 0:
@@ -195,17 +205,18 @@ def render_video(rec, path: str | Path, fps: float = 30.0, width: int = 640, hei
         for k in idx:
             f = fr.frame(rec.qpos[k], rec.contact[k])
             if signals:
-                f = np.concatenate([f, _signal_strip(rec, k, width, strip_h)], axis=0)
+                f = np.concatenate([f, _signal_strip(rec, k, width, strip_h, marks)], axis=0)
             writer.add_image(f)
     return Path(path)
 
 
 def gait_diagram(rec, path: str | Path, metrics=None, title: str = "",
-                 window_s: float | None = 6.0) -> Path:
+                 window_s: float | None = 6.0, marks=()) -> Path:
     """Footfall bars per foot over time (the locomotion literature's gait diagram), PNG.
 
     Shows the last ``window_s`` seconds (None: the whole rollout), so single strides stay
-    readable; the bars are the debounced contacts the metrics are computed from."""
+    readable; the bars are the debounced contacts the metrics are computed from. ``marks``:
+    (time s, label) pairs drawn as labelled vertical lines (a parameter change)."""
     from cpg.plots import _plt
 
     from .gait_metrics import debounce
@@ -218,6 +229,9 @@ def gait_diagram(rec, path: str | Path, metrics=None, title: str = "",
         bars = [(rec.t[s], rec.t[min(e, len(rec.t) - 1)] - rec.t[s])
                 for s, e in zip(edges[::2], edges[1::2])]
         ax.broken_barh(bars, (1 - row, 0.8), facecolor=color, linewidth=0)  # no edge: exact widths
+    for tm, label in marks:
+        ax.axvline(tm, color="k", lw=1.5)
+        ax.text(tm, 1.85, f" {label}", fontsize=8, va="bottom")
     if window_s is not None and len(rec.t):
         ax.set_xlim(max(float(rec.t[0]), float(rec.t[-1]) - window_s), float(rec.t[-1]))
     ax.set_yticks([1.4, 0.4], ["left", "right"])

@@ -100,9 +100,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     seconds = check_seconds(seconds)
     push = check_push(push, seconds)
     K = check_gain(network.kind, feedback)
-    if K > 0 and (to is not None or change is not None):
-        raise InputError("feedback into a network whose parameters change in mid-run is not "
-                         "supported: use one or the other")
+    if (to is None) != (change is None):
+        raise InputError("a parameter change needs both the target network and a schedule")
     if not ankle_drive:
         params = without_ankle_drive(params)
     m = load_model(xml_path)
@@ -113,7 +112,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     if K > 0:
         ctrl = CPGController(m, d, None, params,
                              loop=loop_network(network, K, dt * CONTROL_EVERY, seconds,
-                                               feedback_form))
+                                               feedback_form, to, change))
     else:
         ctrl = CPGController(m, d, cpg_schedule(network, seconds, to=to, change=change), params)
     n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))
@@ -135,8 +134,9 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     P, qvel = ctrl.P, d.qvel
     if K > 0:
         L = ctrl.loop
-        loop_args = (L.code, L.P, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
-                     ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb, ctrl.scratch)
+        loop_args = (L.code, L.P, L.P_ab, L.knots, L.y, L.gain, L.n_sub, L.h, L.noise,
+                     L.act_centre, L.act_width, ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb,
+                     ctrl.scratch)
 
         def tick(k):
             return kernel.tick_closed(k, d.time, *loop_args, P, S, qpos, qvel, sens, xpos, act,
@@ -207,7 +207,7 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_
             L = ctrl.loop
             k_next, status = run_ticks_closed(
                 m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY, d.time, dt, L.code,
-                L.P, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
+                L.P, L.P_ab, L.knots, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
                 ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb, ctrl.scratch, ctrl.P, ctrl.S, *args)
         if bad_qacc.number:  # somewhere in this chunk: keep the rows recorded before it
             return max(k - 1, 0), fell, f"physics became unstable at t={d.time:.3f} s"

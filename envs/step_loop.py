@@ -67,14 +67,14 @@ def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, 
 
 
 @njit
-def run_ticks_closed(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, code, NP, y,
-                     K, n_sub, h, noise, act_c, act_w, weight_n, tick_s, sensors, fb, scratch, P,
+def run_ticks_closed(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, code, NP,
+                     P_ab, knots, y, K, n_sub, h, noise, act_c, act_w, weight_n, tick_s, sensors, fb, scratch, P,
                      S, qpos,
                      qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec, fall_height,
                      fall_pitch, push_tick, push_force, xfrc, torso_id):
     """:func:`run_ticks` with the CPG stepped in the loop (:func:`envs.control_kernel.tick_closed`)."""
     for k in range(k0, k_end):
-        status = kernel.tick_closed(k, t_s, code, NP, y, K, n_sub, h, noise, act_c, act_w,
+        status = kernel.tick_closed(k, t_s, code, NP, P_ab, knots, y, K, n_sub, h, noise, act_c, act_w,
                                     weight_n, tick_s, sensors, fb, scratch, P, S, qpos, qvel, sens, xpos,
                                     act, ctrl, afrc, avel, ix, v, a, rec, fall_height, fall_pitch)
         if k > 0 and status == 2:
