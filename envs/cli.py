@@ -744,6 +744,23 @@ def cmd_sweep(a) -> int:
     return 0
 
 
+def cmd_check_secondary(a) -> int:
+    from cpg import io
+    from envs.secondary_check import check_secondary, load_secondary, table
+
+    n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
+    res = check_secondary(a.secondary, a.seconds, a.workers)
+    if a.json:
+        print(io.to_json(res))
+    else:
+        print(f"{n} secondary weight sets of {a.secondary} through the body ({a.seconds:g} s "
+              f"after settling):")
+        print(table(res))
+        print(f"{sum(r['confirmed'] for r in res.values())} confirmed in the body (both "
+              f"classifiers name the target, no fall)")
+    return 0
+
+
 # --------------------------------------------------------------------------------------- demo
 def cmd_demo(a) -> int:
     from envs.demo import run_demo
@@ -944,6 +961,19 @@ def build_parser() -> argparse.ArgumentParser:
                     metavar="K", help=FEEDBACK_HELP + " (Morris-Lecar)")
     sp.add_argument("--video", action="store_true", help="also render the sweep to mp4")
     sp.add_argument("--out", default="out/sweep", metavar="DIR")
+    sp.add_argument("--json", action="store_true", help="print JSON")
+
+    sp = add("check-secondary", cmd_check_secondary,
+             "run the secondary gaits found by 'secondary' through the body", """\
+        Every weight set of a 'cpgbiped secondary' results file (DIR/secondary.json): the
+        12 directed weights with I_app and phi, from the Table 3 state of the gait they were
+        broken from, drive the body through the one controller. Prints the gait the CPG
+        classifier names and the physical gait (primary patterns, then skip, gallop,
+        hesitation walk, asymmetric hop, one-legged hop from the contacts alone).""")
+    sp.add_argument("secondary", metavar="SECONDARY.json", help="cpgbiped secondary's result")
+    sp.add_argument("--seconds", type=seconds_arg, default=20.0,
+                    help="simulated seconds after 2 s of settling (default 20)")
+    sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("check-pareto", cmd_check_pareto, "run an optimiser result's Pareto points in physics",

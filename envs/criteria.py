@@ -307,3 +307,118 @@ def criteria_markdown() -> str:
     rows += [f"| {g} | {c.describe_pattern()} | {c.describe_quality()} |"
              for g, c in CRITERIA.items()]
     return "\n".join(rows) + "\n"
+
+
+# ------------------------------------------------------------------- secondary gaits
+@dataclass(frozen=True)
+class SecondaryPattern:
+    """A secondary gait of the network as the contacts show it (names as cpg.gaits). Checked
+    only when no primary gait's pattern matches, in the order of SECONDARY_PATTERNS. Lags are
+    the left-right touchdown lag in strides (0 together, 0.5 alternating), its distance
+    circular; flight and duty as fractions of the window."""
+
+    name: str
+    description: str
+    check: str  # the rule, in words that mirror secondary_failures()
+
+
+LAG_TOGETHER = 0.10  # within this of 0: feet land together
+LAG_AWAY = 0.12  # at least this far from 0 and from 0.5: a held lag (gallop)
+LAG_UNEQUAL = 0.06  # alternating steps at least this far from 0.5: unequal step times
+SECONDARY_FLIGHT = 0.05  # flight fraction that counts as flight
+ONE_LEG_DUTY = 0.10  # a foot on the ground less than this is "almost never" down
+DUTY_UNEQUAL = 0.15  # |duty L - duty R| of an asymmetric hop
+SKIP_PAIRS = 0.6  # fraction of same-foot touchdown runs of length two (L L R R)
+
+SECONDARY_PATTERNS = {
+    "one_legged_hop": SecondaryPattern(
+        "one_legged_hop", "one foot almost never on the ground while the other hops",
+        f"one foot's duty < {ONE_LEG_DUTY}, the other >= 3 touchdowns, flight >= "
+        f"{SECONDARY_FLIGHT}"),
+    "skip": SecondaryPattern(
+        "skip", "each foot lands twice in a row: left-left-right-right",
+        f">= 4 runs of same-foot touchdowns, >= {SKIP_PAIRS:.0%} of the inner runs of length 2"),
+    "asymmetric_hop": SecondaryPattern(
+        "asymmetric_hop", "feet together, with unequal duty",
+        f"lag within {LAG_TOGETHER} of 0, duties of L and R differ by >= {DUTY_UNEQUAL}, flight >= "
+        f"{SECONDARY_FLIGHT}"),
+    "gallop": SecondaryPattern(
+        "gallop", "a left-right lag held away from both 0 and 0.5, with flight",
+        f"lag >= {LAG_AWAY} from 0 and from 0.5, flight >= {SECONDARY_FLIGHT}, about one "
+        f"footfall per foot and stride"),
+    "hesitation_walk": SecondaryPattern(
+        "hesitation_walk", "alternating steps with an unequal step rhythm",
+        f"no flight (< {SECONDARY_FLIGHT}), lag >= {LAG_UNEQUAL} from 0.5 and >= {LAG_AWAY} "
+        f"from 0, about one footfall per foot and stride"),
+}
+
+
+def _circ(a: float, b: float) -> float:
+    d = abs(a - b) % 1.0
+    return min(d, 1.0 - d)
+
+
+def secondary_failures(name: str, m) -> list[str]:
+    """What of secondary gait ``name``'s pattern a GaitMetrics (or its dict) misses."""
+    g = (lambda k: m[k]) if isinstance(m, dict) else (lambda k: getattr(m, k))  # noqa: E731
+    duty = g("duty_factor")
+    dl, dr = duty["left"], duty["right"]
+    td = g("touchdowns")
+    nl, nr = len(td["left"]), len(td["right"])
+    lag, flight = g("lr_phase_lag"), g("flight")
+    fps = g("footfalls_per_stride") or {"left": float("nan"), "right": float("nan")}
+    one_each = all(0.8 <= fps[k] <= 1.25 for k in ("left", "right"))
+    out = []
+    if name == "one_legged_hop":
+        if not (min(dl, dr) < ONE_LEG_DUTY and max(nl, nr) >= 3):
+            out.append("both feet share the ground")
+        if not flight >= SECONDARY_FLIGHT:
+            out.append(f"flight {flight:.2f} < {SECONDARY_FLIGHT}")
+        return out
+    if min(nl, nr) < 3 or not np.isfinite(lag):
+        return ["fewer than 3 touchdowns of a foot"]
+    if name == "skip":
+        seq = sorted([(t, 0) for t in td["left"]] + [(t, 1) for t in td["right"]])
+        feet = [f for _, f in seq]
+        runs_, n = [], 1
+        for a, b in zip(feet[:-1], feet[1:]):
+            if a == b:
+                n += 1
+            else:
+                runs_.append(n)
+                n = 1
+        inner = runs_[1:]  # the first run may be cut by the window
+        if len(inner) < 3 or np.mean([r == 2 for r in inner]) < SKIP_PAIRS:
+            out.append("feet do not land twice in a row")
+    elif name == "asymmetric_hop":
+        if _circ(lag, 0.0) > LAG_TOGETHER:
+            out.append(f"lag {lag:.2f}: feet not together")
+        if abs(dl - dr) < DUTY_UNEQUAL:
+            out.append(f"duties {dl:.2f}/{dr:.2f} not unequal")
+        if not flight >= SECONDARY_FLIGHT:
+            out.append(f"flight {flight:.2f} < {SECONDARY_FLIGHT}")
+    elif name == "gallop":
+        if _circ(lag, 0.0) < LAG_AWAY or _circ(lag, 0.5) < LAG_AWAY:
+            out.append(f"lag {lag:.2f} not held away from 0 and 0.5")
+        if not flight >= SECONDARY_FLIGHT:
+            out.append(f"flight {flight:.2f} < {SECONDARY_FLIGHT}")
+        if not one_each:
+            out.append("not one footfall per foot and stride")
+    elif name == "hesitation_walk":
+        if not flight < SECONDARY_FLIGHT:
+            out.append(f"flight {flight:.2f}")
+        if _circ(lag, 0.5) < LAG_UNEQUAL or _circ(lag, 0.0) < LAG_AWAY:
+            out.append(f"lag {lag:.2f}: steps not alternating with unequal times")
+        if not one_each:
+            out.append("not one footfall per foot and stride")
+    else:
+        raise KeyError(name)
+    return out
+
+
+def secondary_markdown() -> str:
+    """The secondary patterns as the Markdown table the README shows."""
+    rows = ["| secondary gait | what it is | rule (contacts only) |", "|---|---|---|"]
+    rows += [f"| {g.replace('_', ' ')} | {p.description} | {p.check} |"
+             for g, p in SECONDARY_PATTERNS.items()]
+    return "\n".join(rows) + "\n"

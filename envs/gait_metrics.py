@@ -134,14 +134,23 @@ def ankle_excursion(t: np.ndarray, stance: np.ndarray, ankle: np.ndarray) -> flo
 
 
 def classify_physical(m: GaitMetrics) -> str:
-    from .criteria import CRITERIA
+    """The primary gait whose pattern the contacts match (envs.criteria.CRITERIA), else the
+    first secondary one that matches (SECONDARY_PATTERNS), else "none". The skip is checked
+    first: its same-foot double landings (L L R R) halve each foot's median touchdown interval,
+    which makes its lag look like a run's; no primary gait lands a foot twice in a row."""
+    from .criteria import CRITERIA, SECONDARY_PATTERNS, secondary_failures
 
-    if m.fell or min(len(m.touchdowns["left"]), len(m.touchdowns["right"])) < 3:
+    if m.fell:
         return "none"
-    if not np.isfinite(m.lr_phase_lag):
-        return "none"
-    for name, c in CRITERIA.items():
-        if not c.pattern_failures(m):
+    if not secondary_failures("skip", m):
+        return "skip"
+    if min(len(m.touchdowns["left"]), len(m.touchdowns["right"])) >= 3 and np.isfinite(
+            m.lr_phase_lag):
+        for name, c in CRITERIA.items():
+            if not c.pattern_failures(m):
+                return name
+    for name in SECONDARY_PATTERNS:
+        if not secondary_failures(name, m):
             return name
     return "none"
 

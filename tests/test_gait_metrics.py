@@ -68,12 +68,43 @@ def test_ankle_excursion_in_stance_by_construction():
 
 def test_one_leg_hopping_while_the_other_taps_is_not_a_hop():
     """Both feet land together, flight 24%, mean duty 0.43: a hop by every other number, but the
-    left foot only taps (duty 0.11) while the right carries the stance (0.75)."""
+    left foot only taps (duty 0.11) while the right carries the stance (0.75): feet together
+    with unequal duty, the asymmetric hop of the network's secondary gaits."""
     c = np.stack([foot(0.4, 0.11, 0.0), foot(0.4, 0.75, 0.0)], axis=1)
     m = gm.measure(T, c, 0.0 * T, settle_s=2.0)
     assert m.duty_factor["left"] == pytest.approx(0.11, abs=0.01)
     assert m.duty_factor["right"] == pytest.approx(0.75, abs=0.01)
-    assert m.physical_gait == "none"
+    assert m.physical_gait == "asymmetric_hop"
+
+
+def _skip(period=0.8, stance=0.12):
+    """Left lands at 0 and 1/4 of each cycle, right at 1/2 and 3/4: L L R R."""
+    ph = (T / period) % 1.0
+    left = (ph < stance) | ((ph >= 0.25) & (ph < 0.25 + stance))
+    right = ((ph >= 0.5) & (ph < 0.5 + stance)) | ((ph >= 0.75) & (ph < 0.75 + stance))
+    return np.stack([left, right], axis=1)
+
+
+@pytest.mark.parametrize("contact,want", [
+    (_skip(), "skip"),
+    (np.stack([foot(0.7, 0.3, 0.0), foot(0.7, 0.3, 0.25 * 0.7)], axis=1), "gallop"),
+    (np.stack([np.zeros(len(T), bool), foot(0.5, 0.5, 0.0)], axis=1), "one_legged_hop"),
+    (np.stack([foot(0.6, 0.3, 0.0), foot(0.6, 0.6, 0.0)], axis=1), "asymmetric_hop"),
+    (np.stack([foot(1.0, 0.65, 0.0), foot(1.0, 0.65, 0.35)], axis=1), "hesitation_walk"),
+], ids=["skip", "gallop", "one_legged_hop", "asymmetric_hop", "hesitation_walk"])
+def test_secondary_gaits_from_contacts_alone(contact, want):
+    """Each secondary gait of the network (issue 22's definitions) built as a contact series:
+    skip L-L-R-R; gallop: lag 0.25 with flight (0.45 of the stride); one-legged hop: the left
+    foot never down; asymmetric hop: together, duties 0.3/0.6; hesitation walk: alternating
+    steps 0.35/0.65 of a stride apart, never both feet off."""
+    m = gm.measure(T, contact, 0.5 * T, settle_s=2.0)
+    assert m.physical_gait == want
+
+
+def test_a_symmetric_walk_and_run_stay_primary():
+    for period, duty in ((1.0, 0.65), (0.7, 0.35)):
+        c, x = series(period, duty, 0.5)
+        assert gm.measure(T, c, x, settle_s=2.0).physical_gait in ("walk", "run")
 
 
 def test_flicker_is_debounced():
@@ -180,7 +211,8 @@ def test_readme_criteria_table_is_the_criteria_data():
     the classifier, the tests, the tuner and the README read)."""
     from pathlib import Path
 
-    from envs.criteria import criteria_markdown
+    from envs.criteria import criteria_markdown, secondary_markdown
 
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     assert criteria_markdown() in readme
+    assert secondary_markdown() in readme

@@ -1,0 +1,194 @@
+"""Gait transitions and drive sweeps in physics (envs.transition, envs.sweep; issue 22)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from cpg.feedback import RECOMMENDED, loop_network, run_open
+from cpg.integrate import Schedule
+from cpg.network import build
+from envs.rollout import rollout
+from envs.sweep import PERSIST, _first_run, schedule
+from envs.transition import transition
+
+
+def _cli(*args, timeout=300):
+    env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "osmesa"))
+    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+                          text=True, timeout=timeout, env=env)
+
+
+def test_the_stepped_network_follows_its_open_loop_integration_through_a_ramp():
+    """Walk to run over 1 s from 3 s: the closed loop's integrator (parameters held over each
+    4 ms tick) against the open-loop kernel (held over each 0.02-unit step, 1.6 ms): the two
+    holds differ by up to a tick during the ramp, which shifts the phase slightly; 8 s."""
+    a, b = build("ml", "walk"), build("ml", "run")
+    ch = Schedule.change(3.0, 1.0)
+    v = run_open(loop_network(a, 0.0, 0.004, 8.0, to=b, change=ch), 2000)
+    u = a.units_per_s
+    out = a.outputs(8.1 * u, to=b, schedule=ch.scaled(u))
+    t = np.arange(2001) * 0.004
+    ref = np.column_stack([np.interp(t, out.t_model / u, out.v[:, c]) for c in range(4)])
+    assert np.max(np.abs(v - ref)) < 0.02 * np.ptp(ref)
+    # and the parameters did change: after the ramp the cells leave the walk network's orbit
+    w = run_open(loop_network(a, 0.0, 0.004, 8.0), 2000)
+    assert np.max(np.abs(v[t > 5] - w[t > 5])) > 0.3
+
+
+def test_closed_loop_through_a_change_agrees_in_both_loops():
+    a, b = build("ml", "walk"), build("ml", "run")
+    ch = Schedule.change(2.0, 1.0)
+    r1 = rollout(a, 5.0, to=b, change=ch, poses=False, feedback=0.01)
+    r2 = rollout(a, 5.0, to=b, change=ch, poses=True, feedback=0.01)
+    assert np.array_equal(r1.cpg_v, r2.cpg_v) and np.array_equal(r1.com_x, r2.com_x)
+
+
+@pytest.mark.parametrize("K", [0.0, 0.01])
+def test_the_cpg_state_carries_across_a_step(K):
+    """No reset: across a step of the parameters the cells' outputs move no more from one tick
+    to the next than they do elsewhere in the rollout."""
+    res, rec, *_ = transition("ml", "walk", "run", 6.0, 0.0, 9.0, feedback=K)
+    dv = np.abs(np.diff(rec.cpg_v, axis=0)).max(axis=1)
+    k = int(np.searchsorted(rec.t, 6.0))
+    assert dv[k - 3:k + 3].max() <= dv.max() and dv[k - 3:k + 3].max() < 3 * np.percentile(dv, 99)
+
+
+def test_transition_json_and_pictures(tmp_path):
+    out = tmp_path / "t.mp4"
+    r = _cli("transition", "--from", "jump", "--to", "hop", "--at", "6", "--seconds", "12",
+             "--json", "--out", str(out), "--rrd", str(tmp_path / "t.rrd"), "--fps", "10",
+             "--width", "320", "--height", "240")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    for key in ("before", "after", "fell", "cycles_to_switch"):
+        assert key in res
+    assert res["before"]["physical_gait"] and res["after"]["physical_gait"]
+    assert out.stat().st_size > 10_000 and (tmp_path / "t_gait.png").stat().st_size > 5_000
+    from envs.record import read_rrd
+
+    series = read_rrd(tmp_path / "t.rrd")
+    key = next(k for k in series if k.endswith("/events/change"))
+    assert np.allclose(series[key][0], [6.0])
+
+
+@pytest.mark.parametrize("args,says", [
+    (("transition", "--from", "skip", "--to", "run"), "--from"),
+    (("transition", "--from", "walk", "--to", "gallop"), "--to"),
+    (("transition", "--from", "walk", "--to", "run", "--at", "12", "--seconds", "10"), "outside"),
+    (("transition", "--from", "walk", "--to", "run", "--at", "1"), "outside"),
+    (("transition", "--from", "walk", "--to", "run", "--ramp", "-1"), ">= 0"),
+    (("transition", "--from", "walk", "--to", "run", "--network", "matsuoka"), "invalid choice"),
+    (("transition", "--from", "walk", "--to", "run", "--network", "hopf", "--feedback"),
+     "Morris-Lecar"),
+    (("sweep", "--pair", "walk-hop"), "unknown sweep"),
+    (("sweep", "--ramp-seconds", "1"), "[5, 200]"),
+])
+def test_bad_transition_input_is_one_line_and_exit_2(args, says):
+    r = _cli(*args, timeout=120)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cpgbiped: error:") and says in lines[0]
+
+
+def test_the_sweep_schedule_goes_up_holds_and_comes_down():
+    s = schedule(10.0)
+    assert list(s.at([0.0, 4.0, 9.0, 14.0, 16.0, 18.0, 23.0, 28.0, 40.0])) == pytest.approx(
+        [0, 0, 0.5, 1, 1, 1, 0.5, 0, 0])
+
+
+def test_a_switch_needs_persist_windows_in_a_row():
+    ws = [{"g": g} for g in ("a", "b", "a", "b", "b", "b", "b")]
+    assert _first_run(ws, lambda w: w["g"] == "b") is ws[3]
+    assert PERSIST == 3
+    assert _first_run(ws[:5], lambda w: w["g"] == "b") is None
+
+
+def test_sweep_cli_writes_its_json_and_picture(tmp_path):
+    r = _cli("sweep", "--pair", "walk-run", "--ramp-seconds", "10", "--json", "--out",
+             str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert {"switch_up", "switch_down", "hysteresis_drive", "windows"} <= set(res)
+    d = [w["drive"] for w in res["windows"]]
+    assert min(d) == pytest.approx(0.0, abs=1e-9) and max(d) == pytest.approx(1.0, abs=1e-9)
+    assert (tmp_path / "sweep_ml_walk-run.png").stat().st_size > 10_000
+
+
+# -- issue 22's "done when", measured (README "Transitions"); strict xfails --------------------
+IN_FAMILY_SHORTFALL = {
+    ("walk", "run", 0.0): "before: the walk preset is named none physically (its duty 0.52 is "
+                          "below the walk's 0.55, issue 20); after: run, but 6 CPG cycles",
+    ("walk", "run", 2.0): "before: named none (walk duty, issue 20); after the ramp the body "
+                          "never settles into a run within 12 s (sliding windows none/run)",
+    ("run", "walk", 0.0): "after: named none (the walk's duty shortfall, issue 20)",
+    ("run", "walk", 2.0): "falls at 10.0 s, 0 s after the ramp ends",
+    ("jump", "hop", 0.0): "before: the jump preset is named none (issue 20); after: hop in 3 "
+                          "CPG cycles",
+    ("jump", "hop", 2.0): "before: named none (issue 20); after: hop, but 6 CPG cycles",
+    ("hop", "jump", 0.0): "falls at 17.0 s",
+    ("hop", "jump", 2.0): "after: still named hop (the jump is not a jump in physics, issue 20)",
+}
+
+
+@pytest.mark.parametrize("a,b,ramp", [
+    pytest.param(a, b, r, marks=pytest.mark.xfail(raises=AssertionError, strict=True,
+                                                  reason=f"measured: {why}"))
+    for (a, b, r), why in IN_FAMILY_SHORTFALL.items()])
+def test_in_family_transition(a, b, ramp):
+    """Issue 22: no fall; the physical gait before the change is A; after it, B within 4 CPG
+    cycles of the change."""
+    res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0)
+    assert not res["fell"], res["fell_at_s"]
+    assert res["before"]["physical_gait"] == a, res["before"]["physical_gait"]
+    assert res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4, res["windows"]
+
+
+# -- secondary gaits in the body ---------------------------------------------------------------
+def _secondary_file(tmp_path, **change):
+    from cpg.morris_lecar import DIRECTED_NAMES, directed_vector, preset, weight_matrix
+
+    p = preset("walk")
+    w = directed_vector(weight_matrix(np.array(p.weights)))
+    t = {"target": "skip", "source": "walk", "i_app": p.i_app, "phi": p.phi,
+         "directed_weights": dict(zip(DIRECTED_NAMES, w.tolist())), "found": False}
+    t.update(change)
+    path = tmp_path / "secondary.json"
+    path.write_text(json.dumps({"format": "cpgbiped.secondary/1", "targets": [t]}))
+    return path
+
+
+def test_check_secondary_runs_each_weight_set_through_the_body(tmp_path):
+    """The walk's own weights written as a 'skip' target: the body and the CPG both walk (the
+    contacts name the walk preset none, its duty shortfall), so nothing is confirmed."""
+    r = _cli("check-secondary", str(_secondary_file(tmp_path)), "--seconds", "5", "--json")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    row = res["skip"]
+    assert row["cpg_gait"] == "walk" and row["confirmed"] is False
+    assert {"physical_gait", "fell", "duty_factor", "lr_phase_lag"} <= set(row)
+
+
+@pytest.mark.parametrize("change,says", [
+    ({"source": "gallop"}, "malformed"),
+    ({"i_app": "0.2"}, "numbers"),
+    ({"phi": True}, "numbers"),
+    ({"phi": -1.0}, "phi > 0"),
+    ({"directed_weights": {"w_LF->RF": 1.0}}, "12 directed"),
+])
+def test_malformed_secondary_files_fail_before_any_rollout(tmp_path, change, says):
+    r = _cli("check-secondary", str(_secondary_file(tmp_path, **change)), timeout=60)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cpgbiped: error:") and says in lines[0]
+
+
+def test_a_file_that_is_not_a_secondary_result_is_refused(tmp_path):
+    p = tmp_path / "x.json"
+    p.write_text(json.dumps({"format": "cpgbiped.result/1", "targets": []}))
+    r = _cli("check-secondary", str(p), timeout=60)
+    assert r.returncode == 2 and "not a cpgbiped secondary results file" in r.stderr
