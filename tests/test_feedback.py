@@ -146,12 +146,15 @@ def test_bad_feedback_input_is_one_line_and_exit_2(args, says):
     assert r.stdout == ""
 
 
-def test_feedback_cannot_be_combined_with_a_mid_run_parameter_change():
+def test_feedback_through_a_parameter_change_is_the_morris_lecar_networks_only():
     from cpg.integrate import Schedule
 
-    with pytest.raises(InputError, match="mid-run"):
-        rollout(build("ml", "walk"), 2.0, to=build("ml", "run"), change=Schedule.change(1.0),
-                feedback=0.01)
+    with pytest.raises(InputError, match="Morris-Lecar network only"):
+        rollout(build("hopf", "walk"), 2.0, to=build("hopf", "run"),
+                change=Schedule.change(1.0), feedback=1.0)
+    rec = rollout(build("ml", "walk"), 2.0, to=build("ml", "run"), change=Schedule.change(1.0),
+                  feedback=0.01, poses=False)
+    assert rec.feedback_gain == 0.01
     with pytest.raises(InputError):
         check_gain("ml", float("nan"))
 
