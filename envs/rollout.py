@@ -99,7 +99,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     """
     seconds = check_seconds(seconds)
     push = check_push(push, seconds)
-    K = check_gain(network.kind, feedback)
+    K = 0.0 if feedback == 0 else check_gain(network.kind, feedback)  # any Network open loop
     if (to is None) != (change is None):
         raise InputError("a parameter change needs both the target network and a schedule")
     if not ankle_drive:
