@@ -12,8 +12,8 @@ import mujoco
 import numpy as np
 from dm_control.mujoco import Physics as _Physics
 
-from cpg.errors import InputError
-from models import BIPED_SCENE
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.models import BIPED_SCENE
 
 from . import control_kernel as kernel
 from .controller import kernel_index

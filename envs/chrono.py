@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg.io import atomic_path
+from cpgbiped.cpg.io import atomic_path
 
 IN_PLACE_M = 0.6  # m: below this travel over the window the poses are spread by time
 SPREAD_MPS = 1.2  # m/s: the "moving plate" of an in-place gait
@@ -86,12 +86,12 @@ def chronophotograph(rec, path: str | Path, metrics=None, title: str = "", strid
     """Write the chronophotograph of a recording (with joint positions) as a PNG; see the
     module docstring. ``metrics``: its GaitMetrics (touchdowns), ``period_s``: the stride
     period when there are too few touchdowns."""
-    from cpg.plots import _plt
+    from cpgbiped.cpg.plots import _plt
 
     from .gait_metrics import debounce
 
     if rec.qpos.size == 0:
-        from cpg.errors import InputError
+        from cpgbiped.cpg.errors import InputError
 
         raise InputError("the recording holds no joint positions to draw")
     t0, t1 = window(rec, metrics, strides, period_s)

@@ -101,7 +101,7 @@ FEEDBACK_HELP = ("feed the body's sensors back into the CPG, stepped with the ph
 
 def feedback_gain(a, kind: str) -> float:
     """The gain of --feedback [K] for a network of ``kind`` (0 without the option)."""
-    from cpg.feedback import RECOMMENDED, check_gain
+    from cpgbiped.cpg.feedback import RECOMMENDED, check_gain
 
     k = getattr(a, "feedback", None)
     if k is None:
@@ -155,15 +155,15 @@ def out_dir(path: str, option: str = "--out") -> str:
 
 # ---------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(a) -> int:
-    from cpg import io, morris_lecar as ml
-    from cpg.reproduce import reproduce, table
+    from cpgbiped.cpg import io, morris_lecar as ml
+    from cpgbiped.cpg.reproduce import reproduce, table
 
     if a.plot:
         out_dir(a.out)
     results = reproduce(dt=a.dt)
     summary = {g: r.summary() for g, r in results.items()}
     if a.plot:
-        from cpg.plots import plot_gait_signals
+        from cpgbiped.cpg.plots import plot_gait_signals
 
         panels = {g: (r.trajectory.t, r.trajectory.x[0],
                       f"I_app={ml.PRESETS[g].i_app}, phi={ml.PRESETS[g].phi}, "
@@ -184,7 +184,7 @@ def cmd_reproduce(a) -> int:
 def cmd_matsuoka(a) -> int:
     from dataclasses import replace
 
-    from cpg import io, matsuoka as mt
+    from cpgbiped.cpg import io, matsuoka as mt
 
     sets = {"printed": mt.PRINTED, "calibrated": mt.CALIBRATED}
     out = {}
@@ -211,8 +211,8 @@ def cmd_matsuoka(a) -> int:
 
 # --------------------------------------------------------------------------------------- hopf
 def cmd_hopf(a) -> int:
-    from cpg import hopf, io
-    from cpg.gaits import classify
+    from cpgbiped.cpg import hopf, io
+    from cpgbiped.cpg.gaits import classify
 
     p = hopf.HopfParams(beta=a.beta, normalised=a.normalised)
     tr = hopf.primary_gait(a.gait, p, t_end=a.seconds, dt=1e-3, t_record=a.seconds / 2,
@@ -267,16 +267,16 @@ class _progress:
 def _evaluator(a):
     if a.dask is None:
         return None
-    from cpg.optimize import DaskEvaluator
+    from cpgbiped.cpg.optimize import DaskEvaluator
 
     return DaskEvaluator(None if a.dask == "local" else a.dask)
 
 
 def cmd_optimize_physics(a) -> int:
-    from cpg.optimize import RunSettings
-    from envs.physics_optimize import default_settings, optimize_physics
-    from envs.physics_search import check_gait
-    from envs.trials import DaskRunner, PoolRunner, SerialRunner
+    from cpgbiped.cpg.optimize import RunSettings
+    from cpgbiped.envs.physics_optimize import default_settings, optimize_physics
+    from cpgbiped.envs.physics_search import check_gait
+    from cpgbiped.envs.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
     gait = check_gait(a.gait)
@@ -317,17 +317,17 @@ def cmd_optimize_physics(a) -> int:
 
 
 def cmd_tune(a) -> int:
-    from cpg.optimize import RunSettings
-    from envs.controller import GAINS_FILE
-    from envs.controller_tuning import TuneSettings, check_gaits, tune, variables
-    from envs.trials import DaskRunner, PoolRunner, SerialRunner
+    from cpgbiped.cpg.optimize import RunSettings
+    from cpgbiped.envs.controller import GAINS_FILE
+    from cpgbiped.envs.controller_tuning import TuneSettings, check_gaits, tune, variables
+    from cpgbiped.envs.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
                             a.conditions, a.sigma)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
-    from envs.controller import read_gains
+    from cpgbiped.envs.controller import read_gains
 
     read_gains(start)  # a bad starting file is refused before any work
     args = (settings.seconds, 2.0)
@@ -367,11 +367,11 @@ def cmd_optimize(a) -> int:
     for opt in ("froude", "seconds", "trials", "workers", "feedback"):
         if getattr(a, opt) is not None:
             raise _input_error(f"--{opt} belongs to optimize --physics")
-    from cpg.evaluate import SimSettings
-    from cpg.optimize import RunSettings, check_bounds, primary_names
-    from cpg.outdir import ResultDir
-    from cpg.search import checkpoint_name, comparison_markdown, optimize_primary
-    from cpg import io
+    from cpgbiped.cpg.evaluate import SimSettings
+    from cpgbiped.cpg.optimize import RunSettings, check_bounds, primary_names
+    from cpgbiped.cpg.outdir import ResultDir
+    from cpgbiped.cpg.search import checkpoint_name, comparison_markdown, optimize_primary
+    from cpgbiped.cpg import io
 
     out_dir(a.out)
     gaits_ = primary_names(a.gait)
@@ -416,10 +416,10 @@ def cmd_optimize(a) -> int:
 
 
 def cmd_secondary(a) -> int:
-    from cpg import io, morris_lecar as ml
-    from cpg.optimize import SECONDARY_TARGETS, RunSettings
-    from cpg.outdir import ResultDir
-    from cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
+    from cpgbiped.cpg import io, morris_lecar as ml
+    from cpgbiped.cpg.optimize import SECONDARY_TARGETS, RunSettings
+    from cpgbiped.cpg.outdir import ResultDir
+    from cpgbiped.cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
     out_dir(a.out)
     rs = RunSettings(a.pop, a.gens, a.seed)
@@ -461,7 +461,7 @@ def cmd_secondary(a) -> int:
 # ------------------------------------------------------------------------- physical biped
 def _network(a):
     """(Network, label) from --network, --preset, --weights and --seed."""
-    from cpg.network import build
+    from cpgbiped.cpg.network import build
 
     kind = a.network
     preset = a.preset or a.gait
@@ -470,7 +470,7 @@ def _network(a):
         return net, f"{kind} {preset}" + (f", seed {a.seed}" if a.seed is not None else "")
     if kind != "ml":
         raise _input_error("--weights holds Morris-Lecar weights: use it with --network ml")
-    from cpg.results import load_result, point_cell
+    from cpgbiped.cpg.results import load_result, point_cell
 
     data = load_result(a.weights)
     preset = a.preset or data["gait"]
@@ -481,8 +481,8 @@ def _network(a):
 
 
 def _validation(a, stop_on_fall=True, settle_s=None):
-    from envs.criteria import SETTLE_S
-    from envs.validate import check_gait, validate
+    from cpgbiped.envs.criteria import SETTLE_S
+    from cpgbiped.envs.validate import check_gait, validate
 
     check_gait(a.gait)
     net, label = _network(a)
@@ -496,21 +496,21 @@ def _validation(a, stop_on_fall=True, settle_s=None):
 
 
 def _input_error(msg):
-    from cpg.errors import InputError
+    from cpgbiped.cpg.errors import InputError
 
     return InputError(msg)
 
 
 def cmd_validate(a) -> int:
-    from cpg import io
-    from envs.validate import metrics_table
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.validate import metrics_table
 
     out_file(a.rrd, "--rrd", ".rrd")
     v, label = _validation(a)
     s = v.summary()
     s["source"] = label
     if a.rrd:
-        from envs.record import write_rrd
+        from cpgbiped.envs.record import write_rrd
 
         write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)})
     if a.json:
@@ -529,7 +529,7 @@ def cmd_validate(a) -> int:
 
 
 def cmd_render(a) -> int:
-    from envs.render import (check_backend, check_video_size, gait_cycle_picture, gait_diagram,
+    from cpgbiped.envs.render import (check_backend, check_video_size, gait_cycle_picture, gait_diagram,
                              render_video, signals_picture)
 
     check_video_size(a.width, a.height, a.fps, a.seconds)
@@ -543,12 +543,12 @@ def cmd_render(a) -> int:
     gait_diagram(v.recording, stem + "_gait.png", v.metrics, label)
     gait_cycle_picture(v.recording, v.metrics, stem + "_cycle.png", label)
     signals_picture(v.recording, stem + "_signals.png", label)
-    from envs.chrono import chronophotograph, chrono_title
+    from cpgbiped.envs.chrono import chronophotograph, chrono_title
 
     chronophotograph(v.recording, stem + "_chrono.png", v.metrics, chrono_title(label, v),
                      period_s=v.summary()["cpg_period_s"])
     if a.rrd:
-        from envs.record import write_rrd
+        from cpgbiped.envs.record import write_rrd
 
         write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)}, {a.gait: path})
     print(f"wrote {path}, {stem}_chrono.png, {stem}_gait.png, {stem}_cycle.png, "
@@ -558,7 +558,7 @@ def cmd_render(a) -> int:
 
 
 def cmd_log(a) -> int:
-    from envs.record import write_rrd
+    from cpgbiped.envs.record import write_rrd
 
     out_file(a.rrd, "--rrd", ".rrd")
     v, label = _validation(a)
@@ -569,8 +569,8 @@ def cmd_log(a) -> int:
 
 
 def cmd_matrix(a) -> int:
-    from cpg import io
-    from envs.matrix import matrix, matrix_table
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.matrix import matrix, matrix_table
 
     K = feedback_gain(a, a.network)
     res = matrix(a.network, seconds=a.seconds, seed=a.seed, workers=a.workers, feedback=K)
@@ -585,7 +585,7 @@ def cmd_matrix(a) -> int:
 
 
 def cmd_check_pareto(a) -> int:
-    from envs.pareto import check_pareto
+    from cpgbiped.envs.pareto import check_pareto
 
     out_dir(a.out)
     out_file(a.rrd, "--rrd", ".rrd")
@@ -602,9 +602,9 @@ def _gains_to_compare(a, kind: str) -> list[float]:
 
 
 def cmd_robustness(a) -> int:
-    from cpg import io
-    from envs.robustness import envelope_picture, robustness, table
-    from envs.validate import check_gait
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.robustness import envelope_picture, robustness, table
+    from cpgbiped.envs.validate import check_gait
 
     check_gait(a.gait)
     out_dir(a.out)
@@ -627,9 +627,9 @@ def cmd_robustness(a) -> int:
 
 
 def cmd_phase_response(a) -> int:
-    from cpg import io
-    from envs.phase_response import phase_response, picture
-    from envs.validate import check_gait
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.phase_response import phase_response, picture
+    from cpgbiped.envs.validate import check_gait
 
     check_gait(a.gait)
     out_dir(a.out)
@@ -655,9 +655,9 @@ def cmd_phase_response(a) -> int:
 
 
 def cmd_transition(a) -> int:
-    from cpg import io
-    from envs.render import check_backend, check_video_size, gait_diagram, render_video
-    from envs.transition import check_transition, transition
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.render import check_backend, check_video_size, gait_diagram, render_video
+    from cpgbiped.envs.transition import check_transition, transition
 
     seconds = a.seconds if a.seconds is not None else a.at + a.ramp + 12.0
     check_transition(a.network, getattr(a, "from"), a.to, a.at, a.ramp, seconds)
@@ -681,7 +681,7 @@ def cmd_transition(a) -> int:
         gait_diagram(rec, stem + "_gait.png", None, label, window_s=None, marks=marks)
         written += [str(path), stem + "_gait.png"]
     if a.rrd:
-        from envs.record import write_rrd
+        from cpgbiped.envs.record import write_rrd
 
         write_rrd(a.rrd, {f"{src}_to_{dst}": (rec, res)}, marks={f"{src}_to_{dst}": marks})
         written.append(a.rrd)
@@ -705,14 +705,14 @@ def cmd_transition(a) -> int:
 
 
 def cmd_sweep(a) -> int:
-    from cpg import io
-    from envs.sweep import check_pair, picture, sweep
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.sweep import check_pair, picture, sweep
 
     check_pair(a.pair)
     out_dir(a.out)
     K = feedback_gain(a, a.network)
     if a.video:
-        from envs.render import check_backend
+        from cpgbiped.envs.render import check_backend
 
         check_backend()
     res, rec = sweep(a.pair, a.ramp_seconds, a.network, K, poses=a.video)
@@ -721,7 +721,7 @@ def cmd_sweep(a) -> int:
     picture(res, stem + ".png")
     written = [stem + ".json", stem + ".png"]
     if a.video:
-        from envs.render import render_video
+        from cpgbiped.envs.render import render_video
 
         sch_t = [4.0, 4.0 + a.ramp_seconds, 8.0 + a.ramp_seconds, 8.0 + 2 * a.ramp_seconds]
         render_video(rec, stem + ".mp4", 30.0, 640, 480, float(rec.t[-1]), marks=sch_t)
@@ -745,8 +745,8 @@ def cmd_sweep(a) -> int:
 
 
 def cmd_check_secondary(a) -> int:
-    from cpg import io
-    from envs.secondary_check import check_secondary, load_secondary, table
+    from cpgbiped.cpg import io
+    from cpgbiped.envs.secondary_check import check_secondary, load_secondary, table
 
     n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
     res = check_secondary(a.secondary, a.seconds, a.workers)
@@ -763,7 +763,7 @@ def cmd_check_secondary(a) -> int:
 
 # --------------------------------------------------------------------------------------- demo
 def cmd_demo(a) -> int:
-    from envs.demo import run_demo
+    from cpgbiped.envs.demo import run_demo
 
     out_dir(a.out)
     run_demo(a.out, seconds=a.seconds, video_seconds=a.video_seconds, progress=not a.quiet)
@@ -1158,7 +1158,7 @@ GL_BACKENDS = ("osmesa", "egl", "glfw")
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; every failure is one line on stderr: exit 2 for bad input, 1 for
     anything unexpected ("internal error"; the traceback only with --debug), 130 on Ctrl-C."""
-    from cpg.errors import InputError
+    from cpgbiped.cpg.errors import InputError
 
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
@@ -1189,5 +1189,16 @@ def main(argv: list[str] | None = None) -> int:
         return 1
 
 
+def run() -> int:
+    """The console entry point: :func:`main`, then Ctrl-C ignored while the interpreter shuts
+    down (the run is over and its outputs are in place: an interrupt then would only print a
+    traceback and exit -2)."""
+    import signal
+
+    code = main()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return code
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run())

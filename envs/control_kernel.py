@@ -17,11 +17,11 @@ import math
 import numpy as np
 from numba import njit
 
-from cpg.feedback import LOAD_CONTACT, RESET_S
-from cpg.feedback import advance as fb_advance
-from cpg.feedback import blend_at as fb_blend_at
-from cpg.feedback import inputs as fb_inputs
-from cpg.feedback import outputs as fb_outputs
+from cpgbiped.cpg.feedback import LOAD_CONTACT, RESET_S
+from cpgbiped.cpg.feedback import advance as fb_advance
+from cpgbiped.cpg.feedback import blend_at as fb_blend_at
+from cpgbiped.cpg.feedback import inputs as fb_inputs
+from cpgbiped.cpg.feedback import outputs as fb_outputs
 
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in

@@ -90,9 +90,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.integrate import Schedule
-from cpg.network import Network
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import Network
 
 from . import control_kernel as kernel
 
@@ -207,12 +207,12 @@ CONTROL = read_gains()[0]
 @dataclass
 class CPGSchedule:
     """A network's outputs v and activations a (T, 4), LF, RF, LE, RE, on a grid of dt_s
-    seconds from t = 0 (the moment the body starts)."""
+    seconds from t = 0 (the moment the body starts). Numbers only: not the network (nor its
+    preset's name), which the controller never sees."""
 
     v: np.ndarray
     a: np.ndarray
     dt_s: float
-    network: Network
 
     @property
     def t_s(self) -> np.ndarray:
@@ -232,8 +232,7 @@ def cpg_schedule(network: Network, seconds: float, *, to: Network | None = None,
         raise InputError(f"the {network.kind} network diverges (its state leaves the cell's "
                          f"range): it cannot drive the body")
     v = np.ascontiguousarray(out.v, dtype=float)
-    return CPGSchedule(v, np.ascontiguousarray(network.activation(v)), network.dt * every / u,
-                       network)
+    return CPGSchedule(v, np.ascontiguousarray(network.activation(v)), network.dt * every / u)
 
 
 def params_array(p: ControlParams) -> np.ndarray:
@@ -327,7 +326,7 @@ class CPGController:
         self.last_a = np.zeros(4)
         # closed loop: the sensors held over a tick, the feedback terms, work space
         self.weight_n = float(model.body_subtreemass[0] * np.linalg.norm(model.opt.gravity))
-        from cpg.feedback import N_SENSORS
+        from cpgbiped.cpg.feedback import N_SENSORS
 
         self.sensors = np.zeros(N_SENSORS)
         self.fb = np.zeros(4)

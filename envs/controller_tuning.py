@@ -62,7 +62,7 @@ from pathlib import Path
 import numpy as np
 from pymoo.core.problem import Problem
 
-from cpg.errors import InputError
+from cpgbiped.cpg.errors import InputError
 
 from . import control_kernel as kernel
 from .controller import (GAINS_FILE, GAINS_FORMAT, ControlParams, params_array,
@@ -273,7 +273,7 @@ class ControllerTuningProblem(Problem):
 def algorithm_for(settings: TuneSettings, x0: np.ndarray, lo, hi, pop: int, seed: int):
     """The pymoo algorithm of a run, started at ``x0`` (the starting gains' values)."""
     if settings.algorithm == "cmaes":
-        from cpg.cmaes import CMAES
+        from cpgbiped.cpg.cmaes import CMAES
 
         return CMAES(x0, sigma=settings.sigma, pop_size=pop)
     from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -304,7 +304,7 @@ def tune(settings: TuneSettings, rs, out: str | Path, runner, start: str | Path 
     :class:`cpg.optimize.RunSettings` (pop, gens, seed); ``start``: the gains file whose
     values the search starts from and keeps for what it does not search; ``progress(gen, n)``
     and ``note(text)`` (the best score so far) after every generation."""
-    from cpg.outdir import ResultDir
+    from cpgbiped.cpg.outdir import ResultDir
 
     base, provenance = read_gains(start)
     with ResultDir(out) as rd:
@@ -322,9 +322,9 @@ def tune(settings: TuneSettings, rs, out: str | Path, runner, start: str | Path 
 
 def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, progress,
           stop_after, note) -> dict:
-    from cpg.io import write_json
-    from cpg.optimize import run
-    from cpg.search import write_csv
+    from cpgbiped.cpg.io import write_json
+    from cpgbiped.cpg.optimize import run
+    from cpgbiped.cpg.search import write_csv
 
     t0 = time.perf_counter()
     problem = ControllerTuningProblem(settings, base, runner)

@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg import morris_lecar as ml
-from cpg.io import write_json, write_text
-from cpg.outdir import ResultDir
+from cpgbiped.cpg import morris_lecar as ml
+from cpgbiped.cpg.io import write_json, write_text
+from cpgbiped.cpg.outdir import ResultDir
 
 OPTIMIZE_DIR = Path("out/optimize")
 
@@ -15,11 +15,11 @@ OPTIMIZE_DIR = Path("out/optimize")
 def _network(gait: str):
     """The optimiser's weights for the gait when out/optimize/<gait>.json exists, else the
     paper's Table 2 preset; (Network, source label)."""
-    from cpg.network import build
+    from cpgbiped.cpg.network import build
 
     f = OPTIMIZE_DIR / f"{gait}.json"
     if f.exists():
-        from cpg.results import load_result
+        from cpgbiped.cpg.results import load_result
 
         data = load_result(f)
         return build("ml", gait, weights=data["chosen"]["weights"], i_app=data["i_app"],
@@ -30,7 +30,7 @@ def _network(gait: str):
 def run_demo(out: str = "out/demo", seconds: float = 20.0, video_seconds: float = 8.0,
              progress: bool = True) -> dict:
     """The main job; every file appears in ``out`` at once when it succeeds, none otherwise."""
-    from envs.render import check_backend
+    from cpgbiped.envs.render import check_backend
 
     check_backend()
     with ResultDir(out) as rd:
@@ -44,13 +44,13 @@ def run_demo(out: str = "out/demo", seconds: float = 20.0, video_seconds: float 
 def _demo(rd: ResultDir, seconds: float, video_seconds: float, progress: bool) -> dict:
     from tqdm import tqdm
 
-    from cpg.plots import plot_gait_signals
-    from cpg.reproduce import reproduce, table
-    from envs.record import write_rrd
-    from envs.render import (FrameRenderer, gait_cycle_picture, gait_diagram, render_video,
+    from cpgbiped.cpg.plots import plot_gait_signals
+    from cpgbiped.cpg.reproduce import reproduce, table
+    from cpgbiped.envs.record import write_rrd
+    from cpgbiped.envs.render import (FrameRenderer, gait_cycle_picture, gait_diagram, render_video,
                              signals_picture)
-    from envs.chrono import chrono_title, chronophotograph
-    from envs.validate import metrics_table, validate
+    from cpgbiped.envs.chrono import chrono_title, chronophotograph
+    from cpgbiped.envs.validate import metrics_table, validate
 
     steps = ["CPG reproduction"] + [f"physics: {g}" for g in ml.PRIMARY_GAITS] + ["rerun log"]
     bar = tqdm(total=len(steps), desc="demo", unit="step", disable=not progress)
@@ -84,7 +84,7 @@ def _demo(rd: ResultDir, seconds: float, video_seconds: float, progress: bool) -
             frame = fr.frame(v.recording.qpos[k], v.recording.contact[k])
         from PIL import Image
 
-        from cpg.io import atomic_path
+        from cpgbiped.cpg.io import atomic_path
 
         with atomic_path(rd.path(f"{g}_frame.png"), suffix=".png") as tmp:
             Image.fromarray(frame).save(tmp, format="PNG")

@@ -9,8 +9,8 @@ from __future__ import annotations
 import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 
-from cpg.errors import InputError
-from cpg.network import KINDS, PRESETS, build
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.network import KINDS, PRESETS, build
 
 from .rollout import check_seconds
 
@@ -42,7 +42,7 @@ def matrix(kind: str = "ml", seconds: float = 20.0, seed: int | None = None,
         raise InputError(f"--workers must be at least 1, got {workers}")
     for p in PRESETS[kind]:  # a clear error before any process starts
         build(kind, p, seed=seed)
-    from cpg.feedback import check_gain
+    from cpgbiped.cpg.feedback import check_gain
 
     feedback = check_gain(kind, feedback)
     jobs = [(kind, p, seed, seconds, feedback) for p in PRESETS[kind]]

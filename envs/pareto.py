@@ -8,22 +8,22 @@ import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from cpg.errors import InputError
-from cpg.io import to_json, write_json, write_text
-from cpg.outdir import ResultDir
-from cpg.results import load_result, point_cell
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.io import to_json, write_json, write_text
+from cpgbiped.cpg.outdir import ResultDir
+from cpgbiped.cpg.results import load_result, point_cell
 
 
 def _one(args):
     gait, k, weights, i_app, phi, seconds, render_dir = args
-    from cpg.network import build
-    from envs.validate import validate
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.validate import validate
 
     net = build("ml", gait, weights=weights, i_app=i_app, phi=phi)
     v = validate(net, gait, seconds, stop_on_fall=render_dir is None)
     video = None
     if render_dir is not None:
-        from envs.render import render_video
+        from cpgbiped.envs.render import render_video
 
         video = f"point_{k:03d}.mp4"  # beside pareto_check.json
         render_video(v.recording, Path(render_dir) / video, seconds=min(seconds, 8.0), width=480,
@@ -119,7 +119,7 @@ def _write(rd, result, data, gait, points, seconds, results, rrd) -> dict:
                     r["stride_period_s"], r["distance_m"], r["speed_mps"], r["physical_gait"],
                     r["cpg_gait"], r["passed"]])
     if rrd:
-        from envs.record import write_rrd
+        from cpgbiped.envs.record import write_rrd
 
         write_rrd(rrd, {f"point_{k:03d}": results[k][2] for k in sorted(results)})
     write_text(rd.path("pareto_check.md"), markdown)

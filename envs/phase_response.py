@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cpg.network import Network
+from cpgbiped.cpg.network import Network
 
 from .gait_metrics import debounce, edges
 from .robustness import stride_phase
@@ -112,7 +112,7 @@ def picture(results: list[dict], title: str, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cpg.io import atomic_path
+    from cpgbiped.cpg.io import atomic_path
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.2), sharex=True)
     for r, color in zip(results, ("0.3", "tab:red", "tab:blue")):

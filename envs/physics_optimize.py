@@ -22,12 +22,12 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.io import write_json
-from cpg.optimize import RunSettings, run
-from cpg.outdir import ResultDir
-from cpg.results import FORMAT
-from cpg.search import plot_front, write_csv
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.io import write_json
+from cpgbiped.cpg.optimize import RunSettings, run
+from cpgbiped.cpg.outdir import ResultDir
+from cpgbiped.cpg.results import FORMAT
+from cpgbiped.cpg.search import plot_front, write_csv
 
 from .physics_search import (FROUDE_TARGET, I_APP_BOUNDS, OBJECTIVES, PHI_BOUNDS, VARIABLES,
                              WEIGHT_BOUNDS, PhysicsGaitProblem, PhysicsSettings, check_gait,

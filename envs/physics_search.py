@@ -39,8 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 from pymoo.core.problem import Problem
 
-from cpg import morris_lecar as ml
-from cpg.errors import InputError
+from cpgbiped.cpg import morris_lecar as ml
+from cpgbiped.cpg.errors import InputError
 
 from .biped import body_constants
 from .criteria import CRITERIA, SETTLE_S

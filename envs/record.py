@@ -32,8 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.io import atomic_path, to_json
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.io import atomic_path, to_json
 
 from .gait_metrics import debounce, edges
 

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.io import atomic_path
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.io import atomic_path
 
 BACKENDS = {"osmesa": ("libOSMesa", "libosmesa6"), "egl": ("libEGL", "libegl1")}
 CAM_DISTANCE, CAM_LOOKAT_Z = 2.3, 0.68  # m: the tracking camera (side view, 10 deg down)
@@ -56,7 +56,7 @@ MAX_FPS = 240.0  # frames per simulated second
 
 def offscreen_size(xml_path=None) -> tuple[int, int]:
     """(width, height) of the model's off-screen buffer (<visual><global offwidth offheight>)."""
-    from models import BIPED_SCENE
+    from cpgbiped.models import BIPED_SCENE
 
     from .biped import load_model
 
@@ -100,7 +100,7 @@ class FrameRenderer:
                  xml_path=None):
         import mujoco
 
-        from models import BIPED_SCENE
+        from cpgbiped.models import BIPED_SCENE
 
         self.mujoco = mujoco
         check_backend()
@@ -217,7 +217,7 @@ def gait_diagram(rec, path: str | Path, metrics=None, title: str = "",
     Shows the last ``window_s`` seconds (None: the whole rollout), so single strides stay
     readable; the bars are the debounced contacts the metrics are computed from. ``marks``:
     (time s, label) pairs drawn as labelled vertical lines (a parameter change)."""
-    from cpg.plots import _plt
+    from cpgbiped.cpg.plots import _plt
 
     from .gait_metrics import debounce
 
@@ -247,7 +247,7 @@ def gait_diagram(rec, path: str | Path, metrics=None, title: str = "",
 
 def signals_picture(rec, path: str | Path, title: str = "") -> Path:
     """CPG outputs, ankle activations and joint angles of a rollout, PNG."""
-    from cpg.plots import _plt
+    from cpgbiped.cpg.plots import _plt
 
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(9, 6), sharex=True)
@@ -289,7 +289,7 @@ def gait_cycle_picture(rec, metrics, path: str | Path, title: str = "",
     """Hip, knee and ankle angles (deg) and the vertical ground reaction force (body weights)
     of each leg against 0-100% of its gait cycle (touchdown to touchdown), mean +- s.d. over
     the strides of the measured window; the biomechanics convention (SCONE's gait analysis)."""
-    from cpg.plots import _plt
+    from cpgbiped.cpg.plots import _plt
 
     from .biped import body_constants
 

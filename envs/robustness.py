@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cpg.network import Network
+from cpgbiped.cpg.network import Network
 
 from .criteria import SETTLE_S
 from .gait_metrics import debounce, edges
@@ -141,7 +141,7 @@ def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float 
 
 
 def table(res: dict) -> str:
-    from cpg.io import format_table
+    from cpgbiped.cpg.io import format_table
 
     rows = []
     for g in res["by_gain"]:
@@ -165,7 +165,7 @@ def envelope_picture(res: dict, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cpg.io import atomic_path
+    from cpgbiped.cpg.io import atomic_path
 
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
     for g, color in zip(res["by_gain"], ("0.3", "tab:red", "tab:blue", "tab:green")):

@@ -11,11 +11,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.feedback import check_gain, loop_network
-from cpg.integrate import Schedule
-from cpg.network import Network
-from models import BIPED_SCENE
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.feedback import check_gain, loop_network
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import Network
+from cpgbiped.models import BIPED_SCENE
 
 from . import control_kernel as kernel
 from .biped import load_model, scale_friction

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.morris_lecar import DIRECTED_NAMES, PRIMARY_GAITS
-from cpg.results import SECONDARY_FORMAT
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.morris_lecar import DIRECTED_NAMES, PRIMARY_GAITS
+from cpgbiped.cpg.results import SECONDARY_FORMAT
 
 KEYS = ("physical_gait", "cpg_gait", "fell", "fell_at_s", "duty_factor", "lr_phase_lag",
         "flight", "double_support", "stride_period_s", "speed_mps", "footfalls_per_stride")
@@ -64,7 +64,7 @@ def load_secondary(path) -> list[dict]:
 
 def _one(args):
     t, seconds = args
-    from cpg.network import build
+    from cpgbiped.cpg.network import build
 
     from .validate import validate
 
@@ -103,7 +103,7 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2) -> dict:
 
 
 def table(res: dict) -> str:
-    from cpg.io import format_table
+    from cpgbiped.cpg.io import format_table
 
     rows = []
     for name, r in res.items():

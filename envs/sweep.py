@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.integrate import Schedule
-from cpg.network import build
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import build
 
 from .rollout import rollout
 from .transition import _window
@@ -110,7 +110,7 @@ def picture(res: dict, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cpg.io import atomic_path
+    from cpgbiped.cpg.io import atomic_path
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.0), sharex=True,
                                  gridspec_kw={"height_ratios": [3, 1.4]})

@@ -20,8 +20,8 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_control.utils import rewards
 
-from cpg.errors import InputError
-from cpg.network import Network, build
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.network import Network, build
 
 from .biped import Physics, load_physics
 from .controller import CONTROL, ControlParams, CPGController, cpg_schedule
@@ -38,7 +38,7 @@ class CPGLocomotion(base.Task):
                  random=None, random_cpg_state: bool = False, friction_scale: float = 1.0,
                  time_limit: float = DEFAULT_TIME_LIMIT, feedback: float = 0.0):
         super().__init__(random=random)
-        from cpg.feedback import check_gain
+        from cpgbiped.cpg.feedback import check_gain
 
         self.feedback = check_gain(network.kind, feedback)
         self.gait, self.network, self.params = gait, network, params
@@ -55,7 +55,7 @@ class CPGLocomotion(base.Task):
         if self.random_cpg_state:
             net = net.with_state(net.random_state(self.random))
         if self.feedback > 0:  # the network stepped with the physics, one tick per control step
-            from cpg.feedback import loop_network
+            from cpgbiped.cpg.feedback import loop_network
 
             loop = loop_network(net, self.feedback, CONTROL_TIMESTEP, self.time_limit + 1.0)
             self.controller = CPGController(physics.model.ptr, physics.data.ptr, None,
@@ -107,7 +107,7 @@ def load(name: str, weights: str | None = None, network: str = "ml", preset: str
     if name == "free":
         if weights is None:
             raise InputError("task 'free' needs a weights file (an optimiser result JSON)")
-        from cpg.results import load_result
+        from cpgbiped.cpg.results import load_result
 
         data = load_result(weights)
         gait = data["gait"]

@@ -22,9 +22,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.integrate import Schedule
-from cpg.network import PRESETS, build
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import PRESETS, build
 
 from .criteria import SETTLE_S
 from .rollout import check_seconds, rollout

@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from cpg.errors import InputError
+from cpgbiped.cpg.errors import InputError
 
 from .criteria import SETTLE_S
 
@@ -83,7 +83,7 @@ def _num(x) -> float:
 def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
               stop_on_fall: bool = True) -> TrialResult:
     """Roll ``trial`` out for ``settle_s + seconds`` and measure the last ``seconds``."""
-    from cpg.network import build
+    from cpgbiped.cpg.network import build
 
     from .rollout import rollout
     from .validate import measure_recording
@@ -129,7 +129,7 @@ def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SET
     """Roll ``trial`` out and return its summary (:meth:`envs.validate.Validation.summary`,
     the gait named by ``preset``) plus ``survived_s`` (simulated seconds before a fall, the
     whole rollout otherwise), ``total_s`` and ``cpg_period_s``."""
-    from cpg.network import build
+    from cpgbiped.cpg.network import build
 
     from .controller import params_from_array
     from .rollout import rollout
@@ -225,7 +225,7 @@ class DaskRunner(SerialRunner):
     def __init__(self, seconds: float, settle_s: float = SETTLE_S, stop_on_fall: bool = True,
                  address: str | None = None, workers: int = 2):
         super().__init__(seconds, settle_s, stop_on_fall)
-        from cpg.optimize import connect_dask
+        from cpgbiped.cpg.optimize import connect_dask
 
         self.client, self.cluster = connect_dask(address, workers)
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cpg.errors import InputError
-from cpg.gaits import classify
-from cpg.integrate import Schedule
-from cpg.network import Network
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.gaits import classify
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import Network
 
 from .controller import CONTROL, ControlParams
 from .criteria import CRITERIA, SETTLE_S
@@ -62,7 +62,7 @@ class Validation:
 def _feedback_rms(rec: Recording, settle_s: float) -> dict:
     """Root mean square of the feedback term each cell received after settling (zero open
     loop); units of cpg.feedback's equations for the network."""
-    from cpg.morris_lecar import CELLS
+    from cpgbiped.cpg.morris_lecar import CELLS
 
     sel = rec.t >= settle_s
     fb = rec.feedback[sel] if len(rec.feedback) == len(rec.t) else np.zeros((0, 4))
@@ -118,7 +118,7 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
 
 def metrics_table(summaries: dict[str, dict]) -> str:
     """Physical metrics and verdicts as text, from ``Validation.summary()`` per rollout."""
-    from cpg.io import format_table
+    from cpgbiped.cpg.io import format_table
 
     rows = []
     for name, s in summaries.items():

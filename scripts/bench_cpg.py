@@ -17,8 +17,8 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from cpg import analysis, morris_lecar as ml
-from cpg.integrate import DT_ML, ML_RANGE, simulate_ml
+from cpgbiped.cpg import analysis, morris_lecar as ml
+from cpgbiped.cpg.integrate import DT_ML, ML_RANGE, simulate_ml
 
 T_END, T_REC = 500.0, 250.0
 

@@ -16,11 +16,11 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from cpg import morris_lecar as ml
-from cpg.evaluate import SimSettings
-from cpg.integrate import ML_RANGE
-from cpg.optimize import RunSettings
-from cpg.search import optimize_primary
+from cpgbiped.cpg import morris_lecar as ml
+from cpgbiped.cpg.evaluate import SimSettings
+from cpgbiped.cpg.integrate import ML_RANGE
+from cpgbiped.cpg.optimize import RunSettings
+from cpgbiped.cpg.search import optimize_primary
 
 
 def main(argv=None) -> int:

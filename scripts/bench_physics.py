@@ -23,9 +23,9 @@ os.environ.setdefault("MUJOCO_GL", "osmesa")
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from cpg.network import build  # noqa: E402
-from envs.rollout import rollout  # noqa: E402
-from models import BIPED_SCENE  # noqa: E402
+from cpgbiped.cpg.network import build  # noqa: E402
+from cpgbiped.envs.rollout import rollout  # noqa: E402
+from cpgbiped.models import BIPED_SCENE  # noqa: E402
 
 
 def best_of(n, f):
@@ -71,7 +71,7 @@ def main(argv=None) -> int:
     print(f"   plain mj_step, zero control  : {n_steps / t_plain:10.0f} steps/s")
     print(f"   ratio                        : {r_plain:10.2f}   (target >= 0.5)")
 
-    from cpg.feedback import RECOMMENDED
+    from cpgbiped.cpg.feedback import RECOMMENDED
 
     K = RECOMMENDED["ml"]
     rollout(net, 0.5, poses=False, feedback=K)  # compile the closed loop
@@ -82,7 +82,7 @@ def main(argv=None) -> int:
     print(f"   plain mj_step, zero control  : {n_steps / t_plain2:10.0f} steps/s")
     print(f"   ratio                        : {r_cl:10.2f}   (target >= 0.5)")
 
-    from envs.render import FrameRenderer
+    from cpgbiped.envs.render import FrameRenderer
 
     rec = rollout(net, 6.0)
     idx = np.linspace(0, len(rec.t) - 1, a.frames).astype(int)
@@ -115,8 +115,8 @@ def main(argv=None) -> int:
     print(f"   bare mujoco.Renderer loop    : {a.frames / t_bare:10.1f} frames/s")
     print(f"   ratio                        : {r_bare:10.2f}   (target >= 0.9)")
 
-    from envs.gait_metrics import measure
-    from envs.record import write_rrd
+    from cpgbiped.envs.gait_metrics import measure
+    from cpgbiped.envs.record import write_rrd
 
     def without():
         r_ = rollout(net, a.seconds)

@@ -29,8 +29,8 @@ def _plain(args) -> int:
     n_rollouts, steps = args
     import mujoco
 
-    from envs.biped import load_model
-    from models import BIPED_SCENE
+    from cpgbiped.envs.biped import load_model
+    from cpgbiped.models import BIPED_SCENE
 
     m = load_model(BIPED_SCENE)
     for _ in range(n_rollouts):
@@ -51,11 +51,11 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     a = ap.parse_args(argv)
 
-    from cpg import morris_lecar as ml
-    from envs.biped import load_model
-    from envs.criteria import SETTLE_S
-    from envs.trials import PoolRunner, SerialRunner, Trial, chunks
-    from models import BIPED_SCENE
+    from cpgbiped.cpg import morris_lecar as ml
+    from cpgbiped.envs.biped import load_model
+    from cpgbiped.envs.criteria import SETTLE_S
+    from cpgbiped.envs.trials import PoolRunner, SerialRunner, Trial, chunks
+    from cpgbiped.models import BIPED_SCENE
 
     p = ml.preset("walk")
     rng = np.random.default_rng(a.seed)

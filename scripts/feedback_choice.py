@@ -42,10 +42,10 @@ CHOICE_PUSH_AFTER_S = 5.5
 
 def evaluate(job):
     kind, preset, form, K = job
-    from cpg.gaits import classify
-    from cpg.network import build
-    from envs.robustness import push_envelope
-    from envs.rollout import rollout
+    from cpgbiped.cpg.gaits import classify
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.robustness import push_envelope
+    from cpgbiped.envs.rollout import rollout
 
     net = build(kind, preset, seed=CHOICE_SEED)
     ml_form = form if kind == "ml" else None

@@ -27,9 +27,9 @@ from tests.test_physics import CONDITION_IDS, CONDITIONS  # noqa: E402
 
 def _condition(job):
     gait, cid, cond, K = job
-    from cpg.network import build
-    from envs.criteria import WINDOW_S
-    from envs.validate import validate
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.criteria import WINDOW_S
+    from cpgbiped.envs.validate import validate
 
     cond = dict(cond)
     seed = cond.pop("seed", None)
@@ -41,16 +41,16 @@ def _condition(job):
 
 def _robust(job):
     kind, preset, K = job
-    from cpg.network import build
-    from envs.robustness import robustness
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.robustness import robustness
 
     return robustness(build(kind, preset), preset, [0.0, K])
 
 
 def _prc(job):
     kind, preset, K, impulse = job
-    from cpg.network import build
-    from envs.phase_response import phase_response
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.phase_response import phase_response
 
     net = build(kind, preset)
     return [phase_response(net, k, impulse=impulse) for k in (0.0, K)]
@@ -63,11 +63,11 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--img", default=None, help="also copy the pictures here (docs/img)")
     a = ap.parse_args(argv)
-    from cpg.feedback import CHOICE, RECOMMENDED
-    from cpg.io import ensure_dir, write_text
-    from envs.criteria import CRITERIA
-    from envs.phase_response import picture
-    from envs.robustness import envelope_picture, table
+    from cpgbiped.cpg.feedback import CHOICE, RECOMMENDED
+    from cpgbiped.cpg.io import ensure_dir, write_text
+    from cpgbiped.envs.criteria import CRITERIA
+    from cpgbiped.envs.phase_response import picture
+    from cpgbiped.envs.robustness import envelope_picture, table
 
     out = ensure_dir(a.out)
     K_ml, K_hopf = RECOMMENDED["ml"], RECOMMENDED["hopf"]

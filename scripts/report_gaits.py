@@ -28,9 +28,9 @@ from tests.test_physics import (CONDITION_IDS, CONDITIONS, PERTURBATION_IDS,  # 
 
 def _one(job):
     gait, cid, cond = job
-    from cpg.network import build
-    from envs.criteria import WINDOW_S
-    from envs.validate import validate
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.criteria import WINDOW_S
+    from cpgbiped.envs.validate import validate
 
     cond = dict(cond)
     seed = cond.pop("seed", None)
@@ -53,8 +53,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="out/report_gaits")
     ap.add_argument("--workers", type=int, default=2)
     a = ap.parse_args(argv)
-    from cpg.io import write_text
-    from envs.criteria import CRITERIA, alexander_relative_stride
+    from cpgbiped.cpg.io import write_text
+    from cpgbiped.envs.criteria import CRITERIA, alexander_relative_stride
 
     gaits = tuple(CRITERIA)
     jobs = [(g, cid, c) for g in gaits for cid, c in zip(CONDITION_IDS, CONDITIONS)]

@@ -25,11 +25,11 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=20.0)
     a = ap.parse_args(argv)
 
-    from cpg import morris_lecar as ml
-    from cpg.io import write_text
-    from cpg.network import build
-    from cpg.results import load_result, point_cell
-    from envs.validate import validate
+    from cpgbiped.cpg import morris_lecar as ml
+    from cpgbiped.cpg.io import write_text
+    from cpgbiped.cpg.network import build
+    from cpgbiped.cpg.results import load_result, point_cell
+    from cpgbiped.envs.validate import validate
 
     rows = ["| gait | network | w_a, w_b, w_c | I_app, phi | passes criteria | Fr | duty | "
             "flight | λ/L (2.3 Fr^0.3) | CoT | apex cm | stride CV | period-2 |",

@@ -22,7 +22,7 @@ IN_FAMILY = {("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump")}
 
 def _one(job):
     a, b, ramp, K = job
-    from envs.transition import transition
+    from cpgbiped.envs.transition import transition
 
     res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0, K)
     return res
@@ -30,7 +30,7 @@ def _one(job):
 
 def _sweep(job):
     pair, K = job
-    from envs.sweep import sweep
+    from cpgbiped.envs.sweep import sweep
 
     return sweep(pair, 40.0, "ml", K)[0]
 
@@ -42,9 +42,9 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--img", default=None)
     a = ap.parse_args(argv)
-    from cpg.feedback import RECOMMENDED
-    from cpg.io import ensure_dir, write_text
-    from envs.sweep import picture
+    from cpgbiped.cpg.feedback import RECOMMENDED
+    from cpgbiped.cpg.io import ensure_dir, write_text
+    from cpgbiped.envs.sweep import picture
 
     out = ensure_dir(a.out)
     K = RECOMMENDED["ml"]

@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from cpg.network import build
-from envs.biped import body_constants, load_model
-from envs.gait_metrics import G
-from envs.validate import validate
+from cpgbiped.cpg.network import build
+from cpgbiped.envs.biped import body_constants, load_model
+from cpgbiped.envs.gait_metrics import G
+from cpgbiped.envs.validate import validate
 
 
 @pytest.fixture(scope="module")
@@ -28,19 +28,25 @@ def test_froude_from_distance_and_duration(walk):
 
 
 def test_apex_from_the_recorded_com_height():
-    """The jump: each flight's rise of the recorded centre of mass, median."""
+    """The jump's apex against ballistics, not against the library's own algorithm: in a flight
+    the centre of mass rises v^2 / (2 g) above its take-off height, v its vertical speed at
+    take-off. Flights here come from the raw contact forces (no debounce), 40 ms or longer;
+    take-off speeds from central differences of the recorded height."""
     v = validate(build("ml", "jump"), "jump", 10.0)
     rec = v.recording
-    sel = rec.t >= v.settle_s
-    from envs.gait_metrics import debounce
-
-    c = np.stack([debounce(rec.contact[:, i], rec.dt) for i in range(2)], axis=1)[sel]
-    z = rec.com_z[sel]
-    flight = ~c.any(axis=1)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], flight.astype(int), [0]])))
-    rises = [z[a:b].max() - z[a] for a, b in zip(edges[::2], edges[1::2]) if b - a >= 2]
-    assert rises, "no flight"
-    assert v.summary()["apex_height_m"] == pytest.approx(float(np.median(rises)), rel=1e-9)
+    sel = np.flatnonzero(rec.t >= v.settle_s)
+    air = ~(rec.force > 1.0).any(axis=1)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], air[sel].astype(int), [0]])))
+    rises = []
+    for a, b in zip(edges[::2], edges[1::2]):
+        if (b - a) * rec.dt >= 0.04 and 0 < a:
+            k = sel[a]
+            vz = (rec.com_z[k + 1] - rec.com_z[k - 1]) / (2 * rec.dt)
+            if vz > 0:
+                rises.append(vz * vz / (2 * G))
+    assert len(rises) >= 3, "too few flights"
+    apex = v.summary()["apex_height_m"]
+    assert apex == pytest.approx(float(np.median(rises)), rel=0.3, abs=0.004)
 
 
 def test_cost_of_transport_from_force_times_velocity(walk):

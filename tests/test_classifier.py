@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from cpg import analysis, gaits
-from cpg.errors import InputError
+from cpgbiped.cpg import analysis, gaits
+from cpgbiped.cpg.errors import InputError
 
 # Table 4 rewritten in LF, RF, LE, RE order (SEEDS.md), as text: parsed here independently.
 TABLE4 = {

@@ -5,13 +5,13 @@ import sys
 
 import pytest
 
-from envs.cli import main
+from cpgbiped.envs.cli import main
 
 TARGETS = {"walk": (180, 180, 0), "run": (180, 0, 180), "jump": (0, 180, 180), "hop": (0, 0, 0)}
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args], capture_output=True,
                           text=True, timeout=600)
 
 

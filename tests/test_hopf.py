@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from cpg import analysis, gaits, hopf
-from cpg.errors import InputError
+from cpgbiped.cpg import analysis, gaits, hopf
+from cpgbiped.cpg.errors import InputError
 
 
 def integer_cycles(tr, b=0, k=0):

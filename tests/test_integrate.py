@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from cpg import analysis, morris_lecar as ml
-from cpg.errors import InputError
-from cpg.integrate import rk4, simulate_ml
+from cpgbiped.cpg import analysis, morris_lecar as ml
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.integrate import rk4, simulate_ml
 
 
 def preset_args(gait):

@@ -7,9 +7,9 @@ import functools
 
 import pytest
 
-from cpg.errors import InputError
-from envs.criteria import WINDOW_S
-from envs.matrix import matrix, matrix_table
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.envs.criteria import WINDOW_S
+from cpgbiped.envs.matrix import matrix, matrix_table
 
 PRESETS = ("walk", "run", "jump", "hop")
 # Rows the one controller does not reach yet (measured; README "Status"): row -> (what was

@@ -4,8 +4,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cpg import matsuoka as mt
-from cpg.errors import InputError
+from cpgbiped.cpg import matsuoka as mt
+from cpgbiped.cpg.errors import InputError
 
 
 def test_weight_matrix_pattern():

@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from cpg import morris_lecar as ml
-from cpg.errors import InputError
+from cpgbiped.cpg import morris_lecar as ml
+from cpgbiped.cpg.errors import InputError
 
 
 def single_cell_rhs(u, v, i_app, phi):

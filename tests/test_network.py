@@ -2,13 +2,13 @@
 import numpy as np
 import pytest
 
-from cpg import hopf, matsuoka as mt, morris_lecar as ml
-from cpg.errors import InputError, NotOscillatingError
-from cpg.gaits import classify
-from cpg.integrate import Schedule, simulate_ml
-from cpg.network import (HOPF_PRESETS, KINDS, ML_UNITS_PER_S, PRESETS, blend, build,
+from cpgbiped.cpg import hopf, matsuoka as mt, morris_lecar as ml
+from cpgbiped.cpg.errors import InputError, NotOscillatingError
+from cpgbiped.cpg.gaits import classify
+from cpgbiped.cpg.integrate import Schedule, simulate_ml
+from cpgbiped.cpg.network import (HOPF_PRESETS, KINDS, ML_UNITS_PER_S, PRESETS, blend, build,
                          ml_weights)
-from cpg.reproduce import run_preset
+from cpgbiped.cpg.reproduce import run_preset
 
 
 @pytest.mark.parametrize("kind", KINDS)

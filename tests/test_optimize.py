@@ -4,12 +4,12 @@ import json
 import numpy as np
 import pytest
 
-from cpg import morris_lecar as ml
-from cpg.errors import InputError
-from cpg.evaluate import SimSettings, robustness
-from cpg.optimize import (REFLECTIONS, PrimaryGaitProblem, RunSettings, SymmetryBreakingProblem,
+from cpgbiped.cpg import morris_lecar as ml
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.evaluate import SimSettings, robustness
+from cpgbiped.cpg.optimize import (REFLECTIONS, PrimaryGaitProblem, RunSettings, SymmetryBreakingProblem,
                           load_checkpoint, orbits, run)
-from cpg.search import load_result, optimize_primary
+from cpgbiped.cpg.search import load_result, optimize_primary
 
 QUICK = SimSettings(t_end=250.0, t_settle=150.0)
 
@@ -88,7 +88,7 @@ def test_same_seed_same_result(tmp_path):
 
 
 def test_dask_local_cluster_matches_in_process(tmp_path):
-    from cpg.optimize import DaskEvaluator
+    from cpgbiped.cpg.optimize import DaskEvaluator
 
     ev = DaskEvaluator(n_workers=2)
     try:
@@ -123,8 +123,8 @@ def test_bad_input(tmp_path):
 
 def test_lock_time_on_signals_that_lock_at_a_known_time():
     """Synthetic 4 signals: RF in phase with LF until t=60, in antiphase (walk) after."""
-    from cpg.evaluate import lock_time
-    from cpg.gaits import gait
+    from cpgbiped.cpg.evaluate import lock_time
+    from cpgbiped.cpg.gaits import gait
 
     P = 5.0
     t = np.arange(0.0, 200.0, 0.05)

@@ -8,17 +8,17 @@ import mediapy
 import numpy as np
 import pytest
 
-from envs.gait_metrics import edges
-from envs.record import read_rrd
-from cpg.network import build
-from envs.validate import validate
-from envs.cli import main
+from cpgbiped.envs.gait_metrics import edges
+from cpgbiped.envs.record import read_rrd
+from cpgbiped.cpg.network import build
+from cpgbiped.envs.validate import validate
+from cpgbiped.envs.cli import main
 
 
 def cli(*args, env=None):
     e = dict(os.environ)
     e.update(env or {})
-    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args], capture_output=True,
                           text=True, timeout=900, env=e)
 
 
@@ -67,7 +67,7 @@ def test_matrix_json(capsys):
      "off-screen buffer"),
 ])
 def test_physics_bad_input_one_line(tmp_path, args, msg):
-    r = subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args], capture_output=True, text=True,
                        timeout=300, cwd=tmp_path)
     one_line_error(r, msg)
     assert not list(tmp_path.iterdir())

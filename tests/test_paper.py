@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from cpg import gaits, morris_lecar as ml
-from cpg.integrate import simulate_ml
+from cpgbiped.cpg import gaits, morris_lecar as ml
+from cpgbiped.cpg.integrate import simulate_ml
 
 # The targets written out from the paper's text (phase of RF, LE, RE vs LF, degrees).
 TARGETS = {"walk": (180, 180, 0), "run": (180, 0, 180), "jump": (0, 180, 180), "hop": (0, 0, 0)}

@@ -13,13 +13,13 @@ import shutil
 import numpy as np
 import pytest
 
-from cpg.network import build
-from cpg.reproduce import run_preset
-from envs.criteria import CRITERIA, WINDOW_S
-from envs.gait_metrics import measure
-from envs.rollout import rollout
-from envs.validate import validate
-from models import BIPED_DIR
+from cpgbiped.cpg.network import build
+from cpgbiped.cpg.reproduce import run_preset
+from cpgbiped.envs.criteria import CRITERIA, WINDOW_S
+from cpgbiped.envs.gait_metrics import measure
+from cpgbiped.envs.rollout import rollout
+from cpgbiped.envs.validate import validate
+from cpgbiped.models import BIPED_DIR
 
 GAITS = tuple(CRITERIA)
 CONDITIONS = [dict()] + [dict(seed=k) for k in range(10, 20)] + \
@@ -115,7 +115,7 @@ def test_gait_survives_perturbations(gait, cond):
 def test_jump_and_hop_are_told_apart_by_the_ankle():
     """The two-legged gaits differ where the paper says: the jump's ankle rotates through its
     stances, the hop's is held stiff; in every test condition the split lies between them."""
-    from envs.criteria import ANKLE_SPLIT_DEG
+    from cpgbiped.envs.criteria import ANKLE_SPLIT_DEG
 
     for cond in CONDITIONS:
         j, h = summary("jump", **cond), summary("hop", **cond)

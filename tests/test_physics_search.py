@@ -8,17 +8,17 @@ import sys
 import numpy as np
 import pytest
 
-from cpg import morris_lecar as ml
-from cpg.errors import InputError
-from cpg.optimize import RunSettings, run
-from cpg.results import load_result
-from envs.biped import body_constants
-from envs.gait_metrics import G
-from envs.physics_optimize import choose, optimize_physics, spread
-from envs.physics_search import (I_APP_BOUNDS, PHI_BOUNDS, WEIGHT_BOUNDS, PhysicsGaitProblem,
+from cpgbiped.cpg import morris_lecar as ml
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.optimize import RunSettings, run
+from cpgbiped.cpg.results import load_result
+from cpgbiped.envs.biped import body_constants
+from cpgbiped.envs.gait_metrics import G
+from cpgbiped.envs.physics_optimize import choose, optimize_physics, spread
+from cpgbiped.envs.physics_search import (I_APP_BOUNDS, PHI_BOUNDS, WEIGHT_BOUNDS, PhysicsGaitProblem,
                                  PhysicsSettings, initial_population, paper_point,
                                  perturbations, score)
-from envs.trials import DaskRunner, PoolRunner, SerialRunner, Trial, TrialResult, chunks, run_trial
+from cpgbiped.envs.trials import DaskRunner, PoolRunner, SerialRunner, Trial, TrialResult, chunks, run_trial
 
 # A small budget: the run (named run from a 4 s window) with one perturbation trial.
 SMALL = PhysicsSettings(froude=0.5, seconds=4.0, n_trials=1)
@@ -126,7 +126,7 @@ def test_small_run_result_is_read_by_check_pareto(tmp_path):
     for f in ("run_physics_population.csv", "run_physics_pareto.csv", "run_physics_pareto.png"):
         assert (tmp_path / "a" / f).stat().st_size > 0
     assert [f.name for f in tmp_path.glob(".*")] == [".a.lock"]  # checkpoint, staging gone
-    out = subprocess.run([sys.executable, "-m", "envs.cli", "check-pareto", str(path), "--out",
+    out = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "check-pareto", str(path), "--out",
                           str(tmp_path / "check"), "--seconds", "4", "--first", "2"],
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
@@ -194,7 +194,7 @@ def test_spread_and_choice():
 def test_bad_input_one_line_no_files(tmp_path, args, message):
     out = tmp_path / "res"
     cmd = ["optimize", "--physics", "--gait", "walk", "--out", str(out), "--quiet"]
-    p = subprocess.run([sys.executable, "-m", "envs.cli", *cmd, *args], capture_output=True,
+    p = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *cmd, *args], capture_output=True,
                        text=True, timeout=120)
     assert p.returncode == 2
     lines = p.stderr.strip().splitlines()
@@ -209,8 +209,8 @@ def test_bad_input_one_line_no_files(tmp_path, args, message):
 def test_compiled_loop_gives_the_python_loops_rows(gait, kw):
     """rollout(poses=False) runs the tick loop compiled (envs.step_loop); every recorded row,
     the fall time and the length must be those of the Python loop, bit for bit."""
-    from cpg.network import build
-    from envs.rollout import rollout
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.rollout import rollout
 
     a = rollout(build("ml", gait), 6.0, **kw)
     b = rollout(build("ml", gait), 6.0, poses=False, **kw)

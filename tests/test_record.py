@@ -9,12 +9,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from cpg.errors import InputError
-from cpg.network import build
-from envs.biped import load_model
-from envs.gait_metrics import debounce
-from envs.record import blueprint, read_component, write_rrd
-from envs.validate import validate
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.network import build
+from cpgbiped.envs.biped import load_model
+from cpgbiped.envs.gait_metrics import debounce
+from cpgbiped.envs.record import blueprint, read_component, write_rrd
+from cpgbiped.envs.validate import validate
 
 SECONDS = 6.0
 
@@ -23,7 +23,7 @@ SECONDS = 6.0
 def logged(tmp_path_factory):
     """`cpgbiped log --gait walk` and the same deterministic rollout in this process."""
     rrd = tmp_path_factory.mktemp("rrd") / "walk.rrd"
-    r = subprocess.run([sys.executable, "-m", "envs.cli", "log", "--gait", "walk", "--seconds",
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "log", "--gait", "walk", "--seconds",
                         str(SECONDS), "--rrd", str(rrd)], capture_output=True, text=True,
                        timeout=300)
     assert r.returncode == 0, r.stderr
@@ -103,7 +103,7 @@ def test_blueprint_views_use_the_logged_paths():
 
 
 def test_a_model_without_the_feet_is_refused(tmp_path):
-    from models import BIPED_DIR
+    from cpgbiped.models import BIPED_DIR
 
     for f in ("biped.xml", "scene.xml"):
         shutil.copy(BIPED_DIR / f, tmp_path / f)
@@ -129,3 +129,28 @@ def test_the_web_viewer_draws_the_body_and_the_footfalls(logged, tmp_path):
 
     res = json.loads(r.stdout)
     assert res["loaded"] and res["body"] and res["footfalls"], res
+
+
+def test_the_viewer_check_rejects_a_view_without_the_body(tmp_path):
+    """The README's real screenshot of the web viewer passes; the same screenshot with the 3-D
+    view's body painted over in the view's own background fails the body check (the check once
+    passed an empty 3-D view), and a blank loading screen fails the loaded check."""
+    from pathlib import Path
+
+    from PIL import Image
+
+    from cpgbiped.envs.viewer_check import analyse
+
+    shot = Path(__file__).resolve().parents[1] / "docs" / "img" / "rerun_viewer.png"
+    assert all(analyse(str(shot))[k] for k in ("loaded", "body", "footfalls"))
+    img = np.asarray(Image.open(shot).convert("RGB")).copy()
+    h, w = img.shape[:2]
+    view = img[int(0.08 * h): int(0.9 * h), : int(0.55 * w)]
+    view[:] = np.median(view.reshape(-1, 3), axis=0).astype(np.uint8)
+    empty = tmp_path / "empty_view.png"
+    Image.fromarray(img).save(empty)
+    r = analyse(str(empty))
+    assert r["loaded"] and r["footfalls"] and not r["body"]
+    blank = tmp_path / "blank.png"
+    Image.fromarray(np.full((h, w, 3), 20, np.uint8)).save(blank)
+    assert not analyse(str(blank))["loaded"]

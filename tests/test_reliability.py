@@ -11,8 +11,8 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from cpg import outdir
-from envs.cli import main
+from cpgbiped.cpg import outdir
+from cpgbiped.envs.cli import main
 
 OPT = ["optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--quiet"]
 VOLATILE = ("wall_s", "resumed_from_generation")  # timing: differs between identical runs
@@ -109,26 +109,32 @@ def test_ctrl_c_by_signal_at_many_moments(tmp_path, old_and_new):
     """SIGINT to a real process at moments spread over a run: old or new set, never mixed."""
     d = fresh_old_folder(tmp_path, old_and_new)
     t0 = time.perf_counter()
-    r = subprocess.run([sys.executable, "-m", "envs.cli", *OPT, "--seed", "2", "--out", str(d)],
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--seed", "2", "--out", str(d)],
                        capture_output=True, timeout=300)
     total = time.perf_counter() - t0
     assert r.returncode == 0
     assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    landed = 0  # interrupts that reached a run in progress (not one already finished)
     for frac in np.linspace(0.3, 1.0, 8):
-        p = subprocess.Popen([sys.executable, "-m", "envs.cli", *OPT, "--seed", "2", "--out",
-                              str(d)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        p = subprocess.Popen([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--seed", "2",
+                              "--out", str(d)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         time.sleep(frac * total)
         p.send_signal(2)
         p.wait(timeout=60)
+        err = p.stderr.read().decode()
+        if p.returncode != 0:
+            assert p.returncode == 130 and err.strip().splitlines()[-1] == "cpgbiped: interrupted", err
+            landed += 1
         outdir.recover(d)
         assert snapshot(d) in (old_and_new[1], old_and_new[2]), frac
         if snapshot(d) == old_and_new[2]:
             assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    assert landed >= 3  # most of the moments lie inside the run (30-100% of its length)
 
 
 def test_two_runs_into_one_folder_one_fails_with_one_line(tmp_path):
     d = tmp_path / "both"
-    procs = [subprocess.Popen([sys.executable, "-m", "envs.cli", *OPT, "--seed", str(s), "--out",
+    procs = [subprocess.Popen([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--seed", str(s), "--out",
                                str(d)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                               text=True) for s in (3, 4)]
     results = [(p.wait(timeout=300), p.stderr.read()) for p in procs]
@@ -142,7 +148,7 @@ def test_a_failed_run_does_not_block_the_next(tmp_path):
     """No feasible point (a box where no weight set reaches the hop): one line, no folder, no
     checkpoint left; the next run in that folder succeeds."""
     d = tmp_path / "f"
-    r = subprocess.run([sys.executable, "-m", "envs.cli", *OPT, "--bounds", "-1", "-0.9",
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--bounds", "-1", "-0.9",
                         "--out", str(d)], capture_output=True, text=True, timeout=300)
     assert r.returncode == 2 and "no feasible solution" in r.stderr, r.stderr
     assert not d.exists()
@@ -155,7 +161,7 @@ def test_checkpoint_header_is_checked_before_unpickling(tmp_path):
     being unpickled (unpickling would run its code)."""
     import pickle
 
-    from cpg.optimize import CHECKPOINT_MAGIC, load_checkpoint
+    from cpgbiped.cpg.optimize import CHECKPOINT_MAGIC, load_checkpoint
 
     ran = tmp_path / "ran"
 
@@ -182,9 +188,9 @@ def test_render_memory_does_not_grow_with_length():
     """Frames are streamed to the encoder: the peak of Python-tracked memory while rendering 20x
     more frames stays within a small bound of the short video's (holding the frames would add
     160 x 120 x 3 bytes per frame, about 34 MB for the long one)."""
-    from cpg.network import build
-    from envs.render import render_video
-    from envs.rollout import rollout
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.render import render_video
+    from cpgbiped.envs.rollout import rollout
 
     rec = rollout(build("ml", "walk"), 6.0, stop_on_fall=False)
     peaks = []
@@ -240,8 +246,8 @@ def _bad_inputs(tmp):
 def test_every_bad_input_is_one_line_and_leaves_nothing(tmp_path):
     import pickle
 
-    from cpg.optimize import CHECKPOINT_MAGIC, CHECKPOINT_VERSION
-    from cpg.outdir import ResultDir
+    from cpgbiped.cpg.optimize import CHECKPOINT_MAGIC, CHECKPOINT_VERSION
+    from cpgbiped.cpg.outdir import ResultDir
 
     work = tmp_path / "work"
     work.mkdir()
@@ -253,8 +259,8 @@ def test_every_bad_input_is_one_line_and_leaves_nothing(tmp_path):
         "format": "cpgbiped.optimize/1", "gait": "walk", "i_app": 0.229, "phi": 0.254,
         "chosen": {"weights": [0.39, -0.681, 0.489]}, "pareto": []}))
     # A checkpoint with this run's header that unpickles to the wrong shape (a list).
-    from cpg.evaluate import SimSettings
-    from cpg.optimize import PrimaryGaitProblem, _meta_line
+    from cpgbiped.cpg.evaluate import SimSettings
+    from cpgbiped.cpg.optimize import PrimaryGaitProblem, _meta_line
     from dataclasses import asdict
 
     pr = PrimaryGaitProblem("hop")
@@ -266,7 +272,7 @@ def test_every_bad_input_is_one_line_and_leaves_nothing(tmp_path):
                       + _meta_line(meta) + b"\n" + pickle.dumps([1, 2, 3]))
     before = sorted(os.listdir(work))
     for args, msg in _bad_inputs(work):
-        r = subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+        r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args], capture_output=True,
                            text=True, timeout=300, cwd=work)
         lines = r.stderr.strip().splitlines()
         assert r.returncode in (1, 2), (args, r.stderr)
@@ -280,7 +286,7 @@ def test_every_bad_input_is_one_line_and_leaves_nothing(tmp_path):
 def test_an_unexpected_error_is_one_line_with_exit_1(monkeypatch, capsys):
     """The last-resort handler: any exception that is not bad input becomes one line, exit 1;
     --debug (anywhere on the line) adds the traceback."""
-    import envs.cli as cli
+    import cpgbiped.envs.cli as cli
 
     def boom(a):
         raise RuntimeError("something broke\non two lines")
@@ -310,8 +316,8 @@ def test_an_unexpected_error_is_one_line_with_exit_1(monkeypatch, capsys):
 
 
 def test_broken_mjcf_message_keeps_the_line_number(tmp_path):
-    from cpg.errors import InputError
-    from envs.biped import load_physics
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.envs.biped import load_physics
 
     bad = tmp_path / "broken.xml"
     bad.write_text("<mujoco>\n<worldbody>\n<body>\n</mujoco>\n")

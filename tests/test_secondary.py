@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from cpg import gaits, morris_lecar as ml
-from cpg.evaluate import SimSettings, simulate_batch
-from cpg.optimize import SECONDARY_TARGETS, RunSettings
-from cpg.search import comparison_markdown, secondary_all, write_secondary
+from cpgbiped.cpg import gaits, morris_lecar as ml
+from cpgbiped.cpg.evaluate import SimSettings, simulate_batch
+from cpgbiped.cpg.optimize import SECONDARY_TARGETS, RunSettings
+from cpgbiped.cpg.search import comparison_markdown, secondary_all, write_secondary
 
 
 @pytest.fixture(scope="module")

@@ -9,17 +9,17 @@ import sys
 import numpy as np
 import pytest
 
-from cpg.feedback import RECOMMENDED, loop_network, run_open
-from cpg.integrate import Schedule
-from cpg.network import build
-from envs.rollout import rollout
-from envs.sweep import PERSIST, _first_run, schedule
-from envs.transition import transition
+from cpgbiped.cpg.feedback import RECOMMENDED, loop_network, run_open
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import build
+from cpgbiped.envs.rollout import rollout
+from cpgbiped.envs.sweep import PERSIST, _first_run, schedule
+from cpgbiped.envs.transition import transition
 
 
 def _cli(*args, timeout=300):
     env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "osmesa"))
-    return subprocess.run([sys.executable, "-m", "envs.cli", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args], capture_output=True,
                           text=True, timeout=timeout, env=env)
 
 
@@ -69,7 +69,7 @@ def test_transition_json_and_pictures(tmp_path):
         assert key in res
     assert res["before"]["physical_gait"] and res["after"]["physical_gait"]
     assert out.stat().st_size > 10_000 and (tmp_path / "t_gait.png").stat().st_size > 5_000
-    from envs.record import read_rrd
+    from cpgbiped.envs.record import read_rrd
 
     series = read_rrd(tmp_path / "t.rrd")
     key = next(k for k in series if k.endswith("/events/change"))
@@ -150,7 +150,7 @@ def test_in_family_transition(a, b, ramp):
 
 # -- secondary gaits in the body ---------------------------------------------------------------
 def _secondary_file(tmp_path, **change):
-    from cpg.morris_lecar import DIRECTED_NAMES, directed_vector, preset, weight_matrix
+    from cpgbiped.cpg.morris_lecar import DIRECTED_NAMES, directed_vector, preset, weight_matrix
 
     p = preset("walk")
     w = directed_vector(weight_matrix(np.array(p.weights)))

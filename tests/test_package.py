@@ -1,0 +1,47 @@
+"""One installed namespace: ``cpgbiped`` and nothing else (issue 23)."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_a_wheel_installs_one_top_level_name_with_its_data(tmp_path):
+    """What ``pip install .`` installs: the wheel's top-level names, and the data files the code
+    reads (gains, feedback choice, the MJCF body)."""
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps",
+                        "-q", "-w", str(tmp_path)],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    wheel = next(tmp_path.glob("cpgbiped-*.whl"))
+    names = zipfile.ZipFile(wheel).namelist()
+    top = {n.split("/")[0] for n in names if ".dist-info/" not in n}
+    assert top == {"cpgbiped"}
+    for f in ("cpgbiped/envs/gains.json", "cpgbiped/envs/gains_root.json",
+              "cpgbiped/cpg/feedback_gains.json", "cpgbiped/models/biped/biped.xml",
+              "cpgbiped/models/biped/scene.xml", "cpgbiped/envs/cli.py"):
+        assert f in names, f
+    entry = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("entry_points.txt")))
+    assert b"cpgbiped = cpgbiped.envs.cli:run" in entry
+
+
+def test_no_module_imports_the_folders_as_top_level_packages(tmp_path):
+    """Every module of the package imported from a folder outside the repository: none of them
+    reaches the old top-level names cpg, envs or models (two copies of a module would make two
+    InputError classes)."""
+    code = (
+        "import pkgutil, sys, importlib, cpgbiped\n"
+        "for pkg in ('cpgbiped.cpg', 'cpgbiped.envs', 'cpgbiped.models'):\n"
+        "    m = importlib.import_module(pkg)\n"
+        "    for info in pkgutil.walk_packages(m.__path__, pkg + '.'):\n"
+        "        importlib.import_module(info.name)\n"
+        "bad = sorted(k for k in sys.modules if k.split('.')[0] in ('cpg', 'envs', 'models'))\n"
+        "print(len([k for k in sys.modules if k.startswith('cpgbiped.')]), bad)\n")
+    r = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    n, bad = r.stdout.split(" ", 1)
+    assert int(n) > 40 and bad.strip() == "[]"
