@@ -4,7 +4,7 @@ Open loop (K = 0, the paper's setting) the network is integrated ahead and the b
 follows it. Closed loop (K > 0) the network's state advances one control tick at a time inside
 the compiled physics loop, and the body's sensors enter its equations. This module holds the
 equations and their only implementation; it never imports MuJoCo: the controller
-(:mod:`envs.control_kernel`) measures the sensors and hands them over as plain numbers.
+(:mod:`cpgbiped.envs.control.control_kernel`) measures the sensors and hands them over as plain numbers.
 
 Sensors, per leg l (0 left, 1 right), measured at every control tick:
     n_l = F_l / (M g)       the foot's normal ground load in body weights (0 in the air;

@@ -3,7 +3,7 @@
 ``<gait>.json`` (format "cpgbiped.optimize/1", written by :func:`cpg.search.optimize_primary`):
 ``chosen`` {weights, errors_deg, robustness}, ``pareto`` (list of the same), ``paper``,
 ``settings``, ``i_app`` and ``phi``; ``<gait>_physics.json`` (the same format, ``"kind":
-"physics"``, written by :func:`envs.physics_optimize.optimize_physics`) also gives each point
+"physics"``, written by :func:`cpgbiped.envs.search.physics_optimize.optimize_physics`) also gives each point
 its own ``i_app`` and ``phi`` and its ``objectives``. ``secondary.json`` (format "cpgbiped.secondary/1").
 Readers of results (validate --weights, check-pareto, the demo, the dm_control "free" task)
 import this module only, so they start without loading pymoo.

@@ -1,6 +1,6 @@
 """``python -m cpgbiped ...``: the command line."""
 import sys
 
-from cpgbiped.envs.cli import run
+from cpgbiped.envs.cli.main import run
 
 sys.exit(run())

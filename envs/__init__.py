@@ -11,7 +11,7 @@ if os.environ.get("PYOPENGL_PLATFORM") not in (None, os.environ["MUJOCO_GL"]):
 
 
 def load(name, **options):
-    """``envs.load("walk")``: a dm_control Environment (see :mod:`envs.tasks`)."""
-    from .tasks import load as _load
+    """``cpgbiped.envs.load("walk")``: a dm_control Environment (see :mod:`cpgbiped.envs.simulation.tasks`)."""
+    from cpgbiped.envs.simulation.tasks import load as _load
 
     return _load(name, **options)

@@ -24,7 +24,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cpgbiped.cpg.network import build  # noqa: E402
-from cpgbiped.envs.rollout import rollout  # noqa: E402
+from cpgbiped.envs.simulation.rollout import rollout  # noqa: E402
 from cpgbiped.models import BIPED_SCENE  # noqa: E402
 
 
@@ -82,7 +82,7 @@ def main(argv=None) -> int:
     print(f"   plain mj_step, zero control  : {n_steps / t_plain2:10.0f} steps/s")
     print(f"   ratio                        : {r_cl:10.2f}   (target >= 0.5)")
 
-    from cpgbiped.envs.render import FrameRenderer
+    from cpgbiped.envs.media.render import FrameRenderer
 
     rec = rollout(net, 6.0)
     idx = np.linspace(0, len(rec.t) - 1, a.frames).astype(int)
@@ -115,8 +115,8 @@ def main(argv=None) -> int:
     print(f"   bare mujoco.Renderer loop    : {a.frames / t_bare:10.1f} frames/s")
     print(f"   ratio                        : {r_bare:10.2f}   (target >= 0.9)")
 
-    from cpgbiped.envs.gait_metrics import measure
-    from cpgbiped.envs.record import write_rrd
+    from cpgbiped.envs.gaits.gait_metrics import measure
+    from cpgbiped.envs.media.record import write_rrd
 
     def without():
         r_ = rollout(net, a.seconds)

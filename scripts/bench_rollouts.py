@@ -29,7 +29,7 @@ def _plain(args) -> int:
     n_rollouts, steps = args
     import mujoco
 
-    from cpgbiped.envs.biped import load_model
+    from cpgbiped.envs.simulation.biped import load_model
     from cpgbiped.models import BIPED_SCENE
 
     m = load_model(BIPED_SCENE)
@@ -52,9 +52,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
 
     from cpgbiped.cpg import morris_lecar as ml
-    from cpgbiped.envs.biped import load_model
-    from cpgbiped.envs.criteria import SETTLE_S
-    from cpgbiped.envs.trials import PoolRunner, SerialRunner, Trial, chunks
+    from cpgbiped.envs.simulation.biped import load_model
+    from cpgbiped.envs.gaits.criteria import SETTLE_S
+    from cpgbiped.envs.simulation.trials import PoolRunner, SerialRunner, Trial, chunks
     from cpgbiped.models import BIPED_SCENE
 
     p = ml.preset("walk")

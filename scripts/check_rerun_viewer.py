@@ -95,7 +95,7 @@ def main(argv=None) -> int:
         print(f"check_rerun_viewer: error: {CHROMIUM} is missing (apt-get install chromium)",
               file=sys.stderr)
         return 2
-    from cpgbiped.envs.viewer_check import analyse
+    from cpgbiped.envs.media.viewer_check import analyse
 
     screenshot(a.rrd, a.png, a.wait)
     res = analyse(a.png)

@@ -44,8 +44,8 @@ def evaluate(job):
     kind, preset, form, K = job
     from cpgbiped.cpg.gaits import classify
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.robustness import push_envelope
-    from cpgbiped.envs.rollout import rollout
+    from cpgbiped.envs.experiments.robustness import push_envelope
+    from cpgbiped.envs.simulation.rollout import rollout
 
     net = build(kind, preset, seed=CHOICE_SEED)
     ml_form = form if kind == "ml" else None

@@ -28,8 +28,8 @@ from tests.test_physics import CONDITION_IDS, CONDITIONS  # noqa: E402
 def _condition(job):
     gait, cid, cond, K = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.criteria import WINDOW_S
-    from cpgbiped.envs.validate import validate
+    from cpgbiped.envs.gaits.criteria import WINDOW_S
+    from cpgbiped.envs.gaits.validate import validate
 
     cond = dict(cond)
     seed = cond.pop("seed", None)
@@ -42,7 +42,7 @@ def _condition(job):
 def _robust(job):
     kind, preset, K = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.robustness import robustness
+    from cpgbiped.envs.experiments.robustness import robustness
 
     return robustness(build(kind, preset), preset, [0.0, K])
 
@@ -50,7 +50,7 @@ def _robust(job):
 def _prc(job):
     kind, preset, K, impulse = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.phase_response import phase_response
+    from cpgbiped.envs.experiments.phase_response import phase_response
 
     net = build(kind, preset)
     return [phase_response(net, k, impulse=impulse) for k in (0.0, K)]
@@ -65,9 +65,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     from cpgbiped.cpg.feedback import CHOICE, RECOMMENDED
     from cpgbiped.cpg.io import ensure_dir, write_text
-    from cpgbiped.envs.criteria import CRITERIA
-    from cpgbiped.envs.phase_response import picture
-    from cpgbiped.envs.robustness import envelope_picture, table
+    from cpgbiped.envs.gaits.criteria import CRITERIA
+    from cpgbiped.envs.experiments.phase_response import picture
+    from cpgbiped.envs.experiments.robustness import envelope_picture, table
 
     out = ensure_dir(a.out)
     K_ml, K_hopf = RECOMMENDED["ml"], RECOMMENDED["hopf"]

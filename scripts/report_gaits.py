@@ -29,8 +29,8 @@ from tests.test_physics import (CONDITION_IDS, CONDITIONS, PERTURBATION_IDS,  # 
 def _one(job):
     gait, cid, cond = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.criteria import WINDOW_S
-    from cpgbiped.envs.validate import validate
+    from cpgbiped.envs.gaits.criteria import WINDOW_S
+    from cpgbiped.envs.gaits.validate import validate
 
     cond = dict(cond)
     seed = cond.pop("seed", None)
@@ -54,7 +54,7 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     a = ap.parse_args(argv)
     from cpgbiped.cpg.io import write_text
-    from cpgbiped.envs.criteria import CRITERIA, alexander_relative_stride
+    from cpgbiped.envs.gaits.criteria import CRITERIA, alexander_relative_stride
 
     gaits = tuple(CRITERIA)
     jobs = [(g, cid, c) for g in gaits for cid, c in zip(CONDITION_IDS, CONDITIONS)]

@@ -29,7 +29,7 @@ def main(argv=None) -> int:
     from cpgbiped.cpg.io import write_text
     from cpgbiped.cpg.network import build
     from cpgbiped.cpg.results import load_result, point_cell
-    from cpgbiped.envs.validate import validate
+    from cpgbiped.envs.gaits.validate import validate
 
     rows = ["| gait | network | w_a, w_b, w_c | I_app, phi | passes criteria | Fr | duty | "
             "flight | λ/L (2.3 Fr^0.3) | CoT | apex cm | stride CV | period-2 |",

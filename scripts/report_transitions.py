@@ -22,7 +22,7 @@ IN_FAMILY = {("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump")}
 
 def _one(job):
     a, b, ramp, K = job
-    from cpgbiped.envs.transition import transition
+    from cpgbiped.envs.experiments.transition import transition
 
     res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0, K)
     return res
@@ -30,7 +30,7 @@ def _one(job):
 
 def _sweep(job):
     pair, K = job
-    from cpgbiped.envs.sweep import sweep
+    from cpgbiped.envs.experiments.sweep import sweep
 
     return sweep(pair, 40.0, "ml", K)[0]
 
@@ -44,7 +44,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     from cpgbiped.cpg.feedback import RECOMMENDED
     from cpgbiped.cpg.io import ensure_dir, write_text
-    from cpgbiped.envs.sweep import picture
+    from cpgbiped.envs.experiments.sweep import picture
 
     out = ensure_dir(a.out)
     K = RECOMMENDED["ml"]

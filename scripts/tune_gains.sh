@@ -32,8 +32,8 @@ stage a2 --gait walk,run,jump,hop --conditions 4 --gens 140 --seed 11 --sigma 0.
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys
-from cpgbiped.envs.controller import read_gains
-from cpgbiped.envs.controller_tuning import params_sha256
+from cpgbiped.envs.control.controller import read_gains
+from cpgbiped.envs.search.controller_tuning import params_sha256
 new, _ = read_gains(sys.argv[1])
 old, _ = read_gains("envs/gains.json")
 same = params_sha256(new) == params_sha256(old)

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 
 from cpgbiped.cpg.network import build
-from cpgbiped.envs.biped import body_constants, load_model
-from cpgbiped.envs.gait_metrics import G
-from cpgbiped.envs.validate import validate
+from cpgbiped.envs.simulation.biped import body_constants, load_model
+from cpgbiped.envs.gaits.gait_metrics import G
+from cpgbiped.envs.gaits.validate import validate
 
 
 @pytest.fixture(scope="module")

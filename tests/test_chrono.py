@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from cpgbiped.cpg.network import build
-from cpgbiped.envs.chrono import IN_PLACE_M, chronophotograph, keypoints, window
-from cpgbiped.envs.rollout import rollout
+from cpgbiped.envs.media.chrono import IN_PLACE_M, chronophotograph, keypoints, window
+from cpgbiped.envs.simulation.rollout import rollout
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +26,7 @@ def test_keypoints_are_the_body_segments(walk_rec):
         assert np.allclose(thigh, 0.40, atol=1e-6) and np.allclose(shank, 0.40, atol=1e-6)
         assert np.allclose(foot, 0.24, atol=1e-6)
     # the hip is the torso's origin, as the recording's own body poses place it
-    from cpgbiped.envs.biped import load_model
+    from cpgbiped.envs.simulation.biped import load_model
 
     torso = load_model().body("torso").id
     assert np.allclose(kp["hip"], walk_rec.body_pose[idx][:, torso][:, [0, 2]], atol=1e-9)
@@ -42,7 +42,7 @@ def test_window_is_the_last_whole_strides():
 
 
 def test_picture_is_written(walk_rec, tmp_path):
-    from cpgbiped.envs.gait_metrics import measure
+    from cpgbiped.envs.gaits.gait_metrics import measure
 
     m = measure(walk_rec.t, walk_rec.contact, walk_rec.com_x)
     out = chronophotograph(walk_rec, tmp_path / "c.png", m, "walk")

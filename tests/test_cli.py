@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from cpgbiped.envs.cli import main
+from cpgbiped.envs.cli.main import main
 
 TARGETS = {"walk": (180, 180, 0), "run": (180, 0, 180), "jump": (0, 180, 180), "hop": (0, 0, 0)}
 

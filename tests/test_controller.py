@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from cpgbiped.cpg.network import Network, build
-from cpgbiped.envs import control_kernel as K
-from cpgbiped.envs.biped import load_model
-from cpgbiped.envs.controller import (CONTROL, CPGController, CPGSchedule, cpg_schedule,
+from cpgbiped.envs.control import control_kernel as K
+from cpgbiped.envs.simulation.biped import load_model
+from cpgbiped.envs.control.controller import (CONTROL, CPGController, CPGSchedule, cpg_schedule,
                              without_ankle_drive)
 
 DT = 0.002

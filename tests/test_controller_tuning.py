@@ -12,13 +12,13 @@ from pymoo.core.problem import Problem
 from cpgbiped.cpg.cmaes import CMAES
 from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.optimize import RunSettings
-from cpgbiped.envs import gait_metrics as gm
-from cpgbiped.envs.controller import CONTROL, GAINS_FILE, read_gains
-from cpgbiped.envs.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, ROOT_GAINS_FILE, TuneSettings,
+from cpgbiped.envs.gaits import gait_metrics as gm
+from cpgbiped.envs.control.controller import CONTROL, GAINS_FILE, read_gains
+from cpgbiped.envs.search.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, ROOT_GAINS_FILE, TuneSettings,
                                     check_gaits, rollout_cost, target_speed, tune,
                                     tuning_conditions, variables)
-from cpgbiped.envs.criteria import CRITERIA
-from cpgbiped.envs.trials import SerialRunner
+from cpgbiped.envs.gaits.criteria import CRITERIA
+from cpgbiped.envs.simulation.trials import SerialRunner
 
 DT = 0.004
 T = np.arange(0.0, 12.0, DT)
@@ -173,7 +173,7 @@ def test_the_controller_loads_one_chain_of_tuning_runs():
     the values), with its command, seed and tuning conditions recorded, and the last one
     ended with exactly the parameters the controller loads (scripts/tune_gains.sh re-runs
     the chain)."""
-    from cpgbiped.envs.controller_tuning import ROOT_GAINS_FILE, params_sha256
+    from cpgbiped.envs.search.controller_tuning import ROOT_GAINS_FILE, params_sha256
 
     p, prov = read_gains(GAINS_FILE)
     assert p == CONTROL

@@ -8,7 +8,7 @@ from dm_env import test_utils
 
 from cpgbiped import envs
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.envs.biped import load_physics
+from cpgbiped.envs.simulation.biped import load_physics
 from cpgbiped.models import BIPED_SCENE
 
 
@@ -87,9 +87,9 @@ def test_bad_model_and_task(tmp_path):
 def test_fall_sensors_see_a_body_on_the_floor():
     """The recorder flags a fall from the body-floor contact sensors alone (height and pitch
     thresholds switched off): lying on the back is a fall, standing is not."""
-    from cpgbiped.envs import control_kernel as K
-    from cpgbiped.envs.biped import load_model
-    from cpgbiped.envs.controller import kernel_index
+    from cpgbiped.envs.control import control_kernel as K
+    from cpgbiped.envs.simulation.biped import load_model
+    from cpgbiped.envs.control.controller import kernel_index
 
     m = load_model()
     ix = kernel_index(m)
@@ -121,8 +121,8 @@ ZERO_RESIDUAL_SHORTFALLS = {  # measured (README "Status"), as in tests/test_phy
 def test_environment_with_zero_residual_produces_the_gait(gait):
     """The dm_control environment steps the same CPG controller as the validated rollouts:
     with a zero residual action the body stays up and its contacts name its gait."""
-    from cpgbiped.envs.gait_metrics import measure
-    from cpgbiped.envs.rollout import FALL_HEIGHT, FALL_PITCH
+    from cpgbiped.envs.gaits.gait_metrics import measure
+    from cpgbiped.envs.simulation.rollout import FALL_HEIGHT, FALL_PITCH
 
     env = envs.load(gait, random=1, time_limit=12.0)
     ts = env.reset()

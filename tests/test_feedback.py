@@ -14,7 +14,7 @@ import pytest
 from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.feedback import CHOICE, LOAD_CONTACT, RECOMMENDED, check_gain, loop_network, run_open
 from cpgbiped.cpg.network import build
-from cpgbiped.envs.rollout import rollout
+from cpgbiped.envs.simulation.rollout import rollout
 
 FIXTURE = Path(__file__).with_name("data") / "open_loop_rows.npz"
 # The rollouts recorded in the fixture (before the closed loop existed): network, preset, CPG
@@ -96,7 +96,7 @@ def test_the_thigh_angle_pathway_is_gated_by_ground_contact():
     """Taga form (the Morris-Lecar choice, and the Matsuoka network's): nothing reaches a
     leg's cells while its foot carries less than LOAD_CONTACT body weights, and the flexor
     receives the opposite of the extensor."""
-    from cpgbiped.envs.biped import body_constants
+    from cpgbiped.envs.simulation.biped import body_constants
 
     assert CHOICE["ml"][0] == "angle"
     rec = rollout(build("ml", "walk"), 6.0, poses=False, feedback=0.1)
@@ -114,7 +114,7 @@ def test_the_thigh_angle_pathway_is_gated_by_ground_contact():
 def test_the_phase_response_moves_the_cpg_only_with_feedback():
     """Open loop the network never hears the body: a push leaves its phase exactly where it
     was. With Tegotae feedback (Hopf run, K = 3) a 10 N s push moves it."""
-    from cpgbiped.envs.phase_response import phase_response
+    from cpgbiped.envs.experiments.phase_response import phase_response
 
     net = build("hopf", "run")
     open_, closed = (phase_response(net, K, phases=(0.1, 0.4), impulse=10.0) for K in (0.0, 3.0))
@@ -171,7 +171,7 @@ def test_validate_json_reports_the_feedback_signals():
 def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fall(tmp_path):
     """The command's envelope at one phase, checked against rollouts made here: the impulse it
     reports is survived and the next one up the ladder is not."""
-    from cpgbiped.envs.robustness import HOLD_S, IMPULSE_LADDER_NS, stride_phase
+    from cpgbiped.envs.experiments.robustness import HOLD_S, IMPULSE_LADDER_NS, stride_phase
 
     r = _cli("robustness", "--gait", "run", "--json", "--out", str(tmp_path))
     assert r.returncode == 0, r.stderr
@@ -212,7 +212,7 @@ def test_the_jump_survives_the_test_conditions_with_feedback():
                           "loop; run forwards 5 N s (0.24 N s/kg), as open loop; neither twice "
                           "the open loop's nor 0.5 N s/kg (10.5 N s)")
 def test_feedback_doubles_the_forward_push_envelope_or_reaches_half_a_newton_second_per_kg():
-    from cpgbiped.envs.robustness import push_envelope
+    from cpgbiped.envs.experiments.robustness import push_envelope
 
     for preset in ("walk", "run"):
         net = build("ml", preset)
@@ -228,7 +228,7 @@ def test_feedback_doubles_the_forward_push_envelope_or_reaches_half_a_newton_sec
 def test_the_cpg_classifier_names_each_preset_from_the_closed_loop_cells(preset):
     """Feedback may move the network, but at the recommended gain the four cells still make
     the preset's gait (the gait table's phases, named by cpg.gaits.classify)."""
-    from cpgbiped.envs.validate import validate
+    from cpgbiped.envs.gaits.validate import validate
 
     v = validate(build("ml", preset), None, 20.0, feedback=RECOMMENDED["ml"])
     assert v.cpg_gait == preset
@@ -238,7 +238,7 @@ def test_the_touchdown_pulse_follows_each_landing_for_fifty_milliseconds():
     """Reset form: the extensor receives K (the flexor -K) for RESET_S after each landing,
     the landings taken here from the recorded loads (crossing LOAD_CONTACT upwards)."""
     from cpgbiped.cpg.feedback import RESET_S
-    from cpgbiped.envs.biped import body_constants
+    from cpgbiped.envs.simulation.biped import body_constants
 
     K = 0.05
     rec = rollout(build("ml", "walk"), 8.0, poses=False, feedback=K, feedback_form="reset")

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from cpgbiped.envs import gait_metrics as gm
+from cpgbiped.envs.gaits import gait_metrics as gm
 
 DT = 0.002
 T = np.arange(0.0, 20.0, DT)
@@ -211,7 +211,7 @@ def test_readme_criteria_table_is_the_criteria_data():
     the classifier, the tests, the tuner and the README read)."""
     from pathlib import Path
 
-    from cpgbiped.envs.criteria import criteria_markdown, secondary_markdown
+    from cpgbiped.envs.gaits.criteria import criteria_markdown, secondary_markdown
 
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     assert criteria_markdown() in readme

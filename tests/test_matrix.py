@@ -8,8 +8,8 @@ import functools
 import pytest
 
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.envs.criteria import WINDOW_S
-from cpgbiped.envs.matrix import matrix, matrix_table
+from cpgbiped.envs.gaits.criteria import WINDOW_S
+from cpgbiped.envs.gaits.matrix import matrix, matrix_table
 
 PRESETS = ("walk", "run", "jump", "hop")
 # Rows the one controller does not reach yet (measured; README "Status"): row -> (what was

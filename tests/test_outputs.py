@@ -8,11 +8,11 @@ import mediapy
 import numpy as np
 import pytest
 
-from cpgbiped.envs.gait_metrics import edges
-from cpgbiped.envs.record import read_rrd
+from cpgbiped.envs.gaits.gait_metrics import edges
+from cpgbiped.envs.media.record import read_rrd
 from cpgbiped.cpg.network import build
-from cpgbiped.envs.validate import validate
-from cpgbiped.envs.cli import main
+from cpgbiped.envs.gaits.validate import validate
+from cpgbiped.envs.cli.main import main
 
 
 def cli(*args, env=None):

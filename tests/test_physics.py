@@ -15,10 +15,10 @@ import pytest
 
 from cpgbiped.cpg.network import build
 from cpgbiped.cpg.reproduce import run_preset
-from cpgbiped.envs.criteria import CRITERIA, WINDOW_S
-from cpgbiped.envs.gait_metrics import measure
-from cpgbiped.envs.rollout import rollout
-from cpgbiped.envs.validate import validate
+from cpgbiped.envs.gaits.criteria import CRITERIA, WINDOW_S
+from cpgbiped.envs.gaits.gait_metrics import measure
+from cpgbiped.envs.simulation.rollout import rollout
+from cpgbiped.envs.gaits.validate import validate
 from cpgbiped.models import BIPED_DIR
 
 GAITS = tuple(CRITERIA)
@@ -115,7 +115,7 @@ def test_gait_survives_perturbations(gait, cond):
 def test_jump_and_hop_are_told_apart_by_the_ankle():
     """The two-legged gaits differ where the paper says: the jump's ankle rotates through its
     stances, the hop's is held stiff; in every test condition the split lies between them."""
-    from cpgbiped.envs.criteria import ANKLE_SPLIT_DEG
+    from cpgbiped.envs.gaits.criteria import ANKLE_SPLIT_DEG
 
     for cond in CONDITIONS:
         j, h = summary("jump", **cond), summary("hop", **cond)

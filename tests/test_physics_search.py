@@ -12,13 +12,13 @@ from cpgbiped.cpg import morris_lecar as ml
 from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.optimize import RunSettings, run
 from cpgbiped.cpg.results import load_result
-from cpgbiped.envs.biped import body_constants
-from cpgbiped.envs.gait_metrics import G
-from cpgbiped.envs.physics_optimize import choose, optimize_physics, spread
-from cpgbiped.envs.physics_search import (I_APP_BOUNDS, PHI_BOUNDS, WEIGHT_BOUNDS, PhysicsGaitProblem,
+from cpgbiped.envs.simulation.biped import body_constants
+from cpgbiped.envs.gaits.gait_metrics import G
+from cpgbiped.envs.search.physics_optimize import choose, optimize_physics, spread
+from cpgbiped.envs.search.physics_search import (I_APP_BOUNDS, PHI_BOUNDS, WEIGHT_BOUNDS, PhysicsGaitProblem,
                                  PhysicsSettings, initial_population, paper_point,
                                  perturbations, score)
-from cpgbiped.envs.trials import DaskRunner, PoolRunner, SerialRunner, Trial, TrialResult, chunks, run_trial
+from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner, Trial, TrialResult, chunks, run_trial
 
 # A small budget: the run (named run from a 4 s window) with one perturbation trial.
 SMALL = PhysicsSettings(froude=0.5, seconds=4.0, n_trials=1)
@@ -210,7 +210,7 @@ def test_compiled_loop_gives_the_python_loops_rows(gait, kw):
     """rollout(poses=False) runs the tick loop compiled (envs.step_loop); every recorded row,
     the fall time and the length must be those of the Python loop, bit for bit."""
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.rollout import rollout
+    from cpgbiped.envs.simulation.rollout import rollout
 
     a = rollout(build("ml", gait), 6.0, **kw)
     b = rollout(build("ml", gait), 6.0, poses=False, **kw)

@@ -11,10 +11,10 @@ import pytest
 
 from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.network import build
-from cpgbiped.envs.biped import load_model
-from cpgbiped.envs.gait_metrics import debounce
-from cpgbiped.envs.record import blueprint, read_component, write_rrd
-from cpgbiped.envs.validate import validate
+from cpgbiped.envs.simulation.biped import load_model
+from cpgbiped.envs.gaits.gait_metrics import debounce
+from cpgbiped.envs.media.record import blueprint, read_component, write_rrd
+from cpgbiped.envs.gaits.validate import validate
 
 SECONDS = 6.0
 
@@ -139,7 +139,7 @@ def test_the_viewer_check_rejects_a_view_without_the_body(tmp_path):
 
     from PIL import Image
 
-    from cpgbiped.envs.viewer_check import analyse
+    from cpgbiped.envs.media.viewer_check import analyse
 
     shot = Path(__file__).resolve().parents[1] / "docs" / "img" / "rerun_viewer.png"
     assert all(analyse(str(shot))[k] for k in ("loaded", "body", "footfalls"))

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from cpgbiped.cpg import outdir
-from cpgbiped.envs.cli import main
+from cpgbiped.envs.cli.main import main
 
 OPT = ["optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--quiet"]
 VOLATILE = ("wall_s", "resumed_from_generation")  # timing: differs between identical runs
@@ -189,8 +189,8 @@ def test_render_memory_does_not_grow_with_length():
     more frames stays within a small bound of the short video's (holding the frames would add
     160 x 120 x 3 bytes per frame, about 34 MB for the long one)."""
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.render import render_video
-    from cpgbiped.envs.rollout import rollout
+    from cpgbiped.envs.media.render import render_video
+    from cpgbiped.envs.simulation.rollout import rollout
 
     rec = rollout(build("ml", "walk"), 6.0, stop_on_fall=False)
     peaks = []
@@ -286,7 +286,7 @@ def test_every_bad_input_is_one_line_and_leaves_nothing(tmp_path):
 def test_an_unexpected_error_is_one_line_with_exit_1(monkeypatch, capsys):
     """The last-resort handler: any exception that is not bad input becomes one line, exit 1;
     --debug (anywhere on the line) adds the traceback."""
-    import cpgbiped.envs.cli as cli
+    import cpgbiped.envs.cli.main as cli
 
     def boom(a):
         raise RuntimeError("something broke\non two lines")
@@ -317,7 +317,7 @@ def test_an_unexpected_error_is_one_line_with_exit_1(monkeypatch, capsys):
 
 def test_broken_mjcf_message_keeps_the_line_number(tmp_path):
     from cpgbiped.cpg.errors import InputError
-    from cpgbiped.envs.biped import load_physics
+    from cpgbiped.envs.simulation.biped import load_physics
 
     bad = tmp_path / "broken.xml"
     bad.write_text("<mujoco>\n<worldbody>\n<body>\n</mujoco>\n")

@@ -12,9 +12,9 @@ import pytest
 from cpgbiped.cpg.feedback import RECOMMENDED, loop_network, run_open
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import build
-from cpgbiped.envs.rollout import rollout
-from cpgbiped.envs.sweep import PERSIST, _first_run, schedule
-from cpgbiped.envs.transition import transition
+from cpgbiped.envs.simulation.rollout import rollout
+from cpgbiped.envs.experiments.sweep import PERSIST, _first_run, schedule
+from cpgbiped.envs.experiments.transition import transition
 
 
 def _cli(*args, timeout=300):
@@ -69,7 +69,7 @@ def test_transition_json_and_pictures(tmp_path):
         assert key in res
     assert res["before"]["physical_gait"] and res["after"]["physical_gait"]
     assert out.stat().st_size > 10_000 and (tmp_path / "t_gait.png").stat().st_size > 5_000
-    from cpgbiped.envs.record import read_rrd
+    from cpgbiped.envs.media.record import read_rrd
 
     series = read_rrd(tmp_path / "t.rrd")
     key = next(k for k in series if k.endswith("/events/change"))

@@ -1,0 +1,362 @@
+"""The one controller: any network's four ankle cells plus the body's sensors -> 8 controls.
+
+It never receives a gait name, a preset name or a classifier's verdict, and it has one
+parameter set (:data:`CONTROL`, read from the data file :data:`GAINS_FILE` that
+``cpgbiped tune`` writes) for every gait and every network. Everything that differs between
+gaits comes from the CPG's activations, tick by tick.
+
+Per control tick (every ``control_every`` physics steps; ctrl held in between):
+
+1. CPG. Open loop (the default, as in the paper) the network is integrated ahead from its
+   initial state at t = 0 (when the body starts) and sampled at the tick; closed loop
+   (``loop``, :mod:`cpg.feedback`) it is stepped one tick at a time with the body's sensors;
+   either way t_model = units_per_s * t_s, with
+   the network's fixed time unit (:mod:`cpg.network`). The schedule holds the raw outputs v
+   and the activations a = network.activation(v) in [0, 1] of the cells LF, RF, LE, RE.
+   Per leg i (j the other leg): flexor f_i = a_iF, extensor e_i = a_iE,
+   - swing drive     g_i = (1 - e_i) clip(w_flex f_i + w_cross e_j + swing_rest, 0, 1)
+     (the leg's own flexor burst, or the other leg's extensor burst - a crossed extension -
+     or, by the blended swing_rest, the mere silence of its own extensor),
+   - stance command  e_i >= e_on,
+   and two features of the rhythm, measured online from the CPG signals (<.> running averages
+   with a time constant of 0.5 s), both in [0, 1]:
+     sigma = <e_L e_R> / sqrt(<e_L^2> <e_R^2>)   left-right synchrony of the extensors
+             (1 in phase, 0 in antiphase);
+     kappa = <f_L e_L + f_R e_R> / sqrt(<f_L^2 + f_R^2> <e_L^2 + e_R^2>)   flexor-extensor
+             co-activation (1 co-active: a stiff ankle; 0 alternating: the ankle rotates).
+   The averages start from a neutral prior (sigma = kappa = 0.5 when the body starts: the
+   controller has no opinion about the rhythm until the CPG shows it).
+   The balance and pattern gains (:class:`Corner`: reflex, torso, foot placement, knee) vary
+   continuously with them, bilinearly between their values at the four corners of the
+   (sigma, kappa) square:
+     p = (1-sigma)(1-kappa) p_alternating + (1-sigma) kappa p_alternating_coactive
+         + sigma (1-kappa) p_synchronous + sigma kappa p_synchronous_coactive.
+   A rhythm between the corners (a transition, a secondary gait, other weights) gets gains
+   between theirs. The ankle gain, the swing wiring (e_on, w_flex, w_cross) and contact_hold
+   are shared by all. Nothing depends on a name.
+2. Contacts and modes. A foot is on the ground while its contact force exceeds 1 N or did
+   within the last ``contact_hold`` s. A leg *swings* from the moment its swing drive lifts
+   it - g_i > 0.5 while it stands, the other leg stands with its stance command and no swing
+   drive of its own (a leg never lifts away the only support), in a rhythm whose legs
+   alternate (sigma < SIGMA_LIFT = 0.4: in a synchronous rhythm no leg lifts on its own, both
+   leave the ground together by their push), once per swing drive - until its foot lands
+   again after having left the ground, when the drive is over or x_clear ahead of the hip (a
+   scuff behind that is not a landing) or with the other foot off the ground. Each leg is in
+   one mode:
+   - lift: swinging, its foot still on the ground;
+   - air: swinging, or any foot off the ground (it prepares to land);
+   - support: otherwise.
+   A second latch, "pushed", follows the extensor burst: the leg took off during its burst
+   (it stood on the ground in this burst and is now off it while the other leg is not still
+   pushing on the ground); a landing in the same burst is absorbed, not pushed again. It
+   clears when the burst ends.
+3. Ankles: u_muscle = ankle_gain a (each muscle its own cell's activation; one gain for every
+   gait and network). A balance reflex adds to it on the ground (never replaces it):
+   b = k_ax (x_com - x_sup) + k_av v_com with x_sup the mean centre of the support feet;
+   b > 0 (centre of mass ahead) adds b to the support legs' extensors, b < 0 adds -b to their
+   flexors; clipped to [0, 1]. ``--no-ankle-drive`` sets ankle_gain = 0 (the reflex stays).
+4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
+   tau_torso = kp_t (pitch_d - pitch) - kd_t pitch_rate;
+   legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
+   thigh angle in the world as target
+       theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
+       tau_i = kp_sw (theta - thigh_i) - kd_sw thigh_rate_i  [ - kf_t tau_torso in flight ];
+   support legs share what holds the torso: tau_i = (tau_torso - sum of the others' tau) / n.
+5. Knees:
+   support: drive d_i = e_i (1 - pushed_i); target knee_crouch + (knee_ext - knee_crouch) d_i,
+       stiffness kp = kp_knee + (kp_push - kp_knee) d_i,
+       tau = kp (target - q) - kd_knee q_rate + push d_i
+       (the extensor burst extends the leg - the push-off; outside it the knee yields to a
+       crouch that absorbs the landing and loads the next push);
+   air and lift: target knee_land + (knee_swing - knee_land) g_i h_i,
+       tau = kp_air (target - q) - kd_knee q_rate,
+       h_i = clip((x_hip + x_clear - x_foot_i) / 0.05, 0, 1)
+       (the swing drive tucks the leg while its foot is behind x_clear ahead of the hip - the
+       clearance; past that, or without the drive, the leg extends to land).
+
+What makes the gaits differ is the CPG: left-right extensors in antiphase give alternating
+support (walk, run), in phase both legs push and fly together (jump, hop); synchrony (sigma)
+and flexor-extensor co-activation (kappa) set the leg's stiffness, push, posture and balance
+strategy; the network's period sets the cadence; the ankle muscles follow their cells.
+
+Sign conventions (models/biped/biped.xml): hinges turn about 0 -1 0; hip angle > 0 swings
+the leg forward; knee angle <= 0 (negative = flexed); ankle > 0 lifts the toes; torso pitch
+from the torso's up axis, > 0 leaning forward.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import Network
+
+from cpgbiped.envs.control import control_kernel as kernel
+
+
+@dataclass(frozen=True)
+class Corner:
+    """The blended gains at one corner of the (sigma, kappa) square; units as in the module
+    docstring (angles rad, torques as fractions of the gear, reflex in activation per m and
+    per m/s, x_clear in m)."""
+
+    k_ax: float  # ankle balance reflex: activation per m of COM ahead of the support
+    k_av: float  # ... per m/s of COM velocity
+    kp_t: float  # torso pitch through the support hips
+    kd_t: float
+    pitch_d: float  # torso lean target (rad, forward)
+    theta0: float  # foot placement: thigh angle target (rad from vertical, forward)
+    c_v: float  # ... per m/s of COM speed
+    c_d: float  # ... per m of COM ahead of the support
+    kp_sw: float  # hip gains of a leg placing its foot
+    kd_sw: float
+    kf_t: float  # in flight: hip torque from the torso pitch error (fraction)
+    knee_ext: float  # knee target in the extensor burst on the ground (push)
+    knee_crouch: float  # knee target on the ground outside the burst
+    knee_swing: float  # knee target with full swing drive
+    knee_land: float  # knee target in the air without swing drive
+    kp_knee: float  # knee stiffness on the ground outside the burst (gear per rad)
+    kp_push: float  # ... on the ground in the burst (push)
+    kp_air: float  # ... in the air and lifting
+    kd_knee: float
+    push: float  # knee extension torque per unit of burst drive
+    swing_rest: float  # swing drive while the leg's own extensor is silent
+    x_clear: float  # m: a swinging foot this far ahead of the hip stops tucking and may land
+
+
+@dataclass(frozen=True)
+class ControlParams:
+    """The one controller's parameters: shared ones, and the blended gains at the four corners
+    of the (sigma, kappa) square (see the module docstring). The values live in a data file,
+    :data:`GAINS_FILE`, written by ``cpgbiped tune`` with the command and seed that made them."""
+
+    ankle_gain: float  # ankle muscle ctrl = ankle_gain * CPG activation
+    e_on: float  # extensor activation from which a leg is commanded to stance
+    w_flex: float  # swing drive from the leg's own flexor
+    w_cross: float  # swing drive from the other leg's extensor (crossed extension)
+    contact_hold: float  # s: ground contact held this long after the last touch
+    alternating: Corner  # sigma = 0, kappa = 0 (the walk's rhythm)
+    alternating_coactive: Corner  # sigma = 0, kappa = 1 (the run's)
+    synchronous: Corner  # sigma = 1, kappa = 0 (the two-legged jump's)
+    synchronous_coactive: Corner  # sigma = 1, kappa = 1 (the two-legged hop's)
+
+    def corner(self, name: str) -> Corner:
+        return getattr(self, name)
+
+    def with_corner(self, name: str, **gains) -> "ControlParams":
+        return replace(self, **{name: replace(self.corner(name), **gains)})
+
+
+if tuple(f.name for f in fields(Corner)) != kernel.BLENDED or tuple(
+        f.name for f in fields(ControlParams))[:kernel.N_SHARED] != kernel.SHARED or tuple(
+        f.name for f in fields(ControlParams))[kernel.N_SHARED:] != kernel.CORNERS:
+    raise ImportError("ControlParams and envs.control_kernel's parameter layout disagree")
+
+# The gains file: the controller's parameters and, for each part, the tuning run that made it.
+GAINS_FILE = Path(__file__).with_name("gains.json")
+GAINS_FORMAT = "cpgbiped.gains/1"
+
+
+def params_to_dict(p: ControlParams) -> dict:
+    """{"shared": {name: value}, "corners": {corner: {gain: value}}} (plain floats)."""
+    return {"shared": {n: float(getattr(p, n)) for n in kernel.SHARED},
+            "corners": {c: {g: float(getattr(p.corner(c), g)) for g in kernel.BLENDED}
+                        for c in kernel.CORNERS}}
+
+
+def params_from_dict(d: dict, what: str = "gains") -> ControlParams:
+    """The inverse of :func:`params_to_dict`; every name must be there, finite, and known."""
+    try:
+        shared, corners = d["shared"], d["corners"]
+        if set(shared) != set(kernel.SHARED) or set(corners) != set(kernel.CORNERS) or any(
+                set(corners[c]) != set(kernel.BLENDED) for c in kernel.CORNERS):
+            raise KeyError("names")
+        vals = [float(shared[n]) for n in kernel.SHARED] + [
+            float(corners[c][g]) for c in kernel.CORNERS for g in kernel.BLENDED]
+    except (KeyError, TypeError, ValueError) as e:
+        raise InputError(f"{what}: not a complete set of the controller's parameters "
+                         f"({type(e).__name__}: {e})") from None
+    if not np.all(np.isfinite(vals)):
+        raise InputError(f"{what}: the controller's parameters must be finite numbers")
+    return ControlParams(**{n: float(shared[n]) for n in kernel.SHARED},
+                         **{c: Corner(**{g: float(corners[c][g]) for g in kernel.BLENDED})
+                            for c in kernel.CORNERS})
+
+
+def read_gains(path: str | Path = GAINS_FILE) -> tuple[ControlParams, list]:
+    """(parameters, provenance) of a gains file (:data:`GAINS_FORMAT`)."""
+    import json
+
+    try:
+        d = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise InputError(f"cannot read the gains file {str(path)!r}: {e}") from None
+    if not isinstance(d, dict) or d.get("format") != GAINS_FORMAT:
+        raise InputError(f"{str(path)!r} is not a gains file (format {GAINS_FORMAT})")
+    prov = d.get("provenance", [])
+    return params_from_dict(d, str(path)), prov if isinstance(prov, list) else []
+
+
+# The one parameter set, for every gait and every network.
+CONTROL = read_gains()[0]
+
+
+@dataclass
+class CPGSchedule:
+    """A network's outputs v and activations a (T, 4), LF, RF, LE, RE, on a grid of dt_s
+    seconds from t = 0 (the moment the body starts). Numbers only: not the network (nor its
+    preset's name), which the controller never sees."""
+
+    v: np.ndarray
+    a: np.ndarray
+    dt_s: float
+
+    @property
+    def t_s(self) -> np.ndarray:
+        return np.arange(len(self.v)) * self.dt_s
+
+
+def cpg_schedule(network: Network, seconds: float, *, to: Network | None = None,
+                 change: Schedule | None = None) -> CPGSchedule:
+    """Integrate ``network`` from its initial state for ``seconds`` (plus a margin), in its own
+    time unit; optionally moving its parameters towards ``to`` along ``change`` (knot times in
+    seconds)."""
+    u = network.units_per_s
+    every = max(1, int(round(0.002 * u / network.dt)))  # a sample at least every ~2 ms
+    sched = None if change is None else change.scaled(u)
+    out = network.outputs((seconds + 0.1) * u, record_every=every, to=to, schedule=sched)
+    if out.diverged:
+        raise InputError(f"the {network.kind} network diverges (its state leaves the cell's "
+                         f"range): it cannot drive the body")
+    v = np.ascontiguousarray(out.v, dtype=float)
+    return CPGSchedule(v, np.ascontiguousarray(network.activation(v)), network.dt * every / u)
+
+
+def params_array(p: ControlParams) -> np.ndarray:
+    """The parameters as the float array the compiled kernel unpacks (layout in
+    :mod:`cpgbiped.envs.control.control_kernel`)."""
+    out = [float(getattr(p, n)) for n in kernel.SHARED]
+    for g in kernel.BLENDED:
+        out += [float(getattr(p.corner(c), g)) for c in kernel.CORNERS]
+    return np.array(out)
+
+
+def params_from_array(P: np.ndarray) -> ControlParams:
+    """The inverse of :func:`params_array`."""
+    P = np.asarray(P, float)
+    if P.shape != (kernel.P_SIZE,):
+        raise InputError(f"a controller parameter array has {kernel.P_SIZE} numbers, "
+                         f"got shape {P.shape}")
+    shared = dict(zip(kernel.SHARED, P[:kernel.N_SHARED].tolist()))
+    corners = {c: {} for c in kernel.CORNERS}
+    for n, g in enumerate(kernel.BLENDED):
+        for k, c in enumerate(kernel.CORNERS):
+            corners[c][g] = float(P[kernel.N_SHARED + 4 * n + k])
+    return params_from_dict({"shared": shared, "corners": corners}, "parameter array")
+
+
+def without_ankle_drive(p: ControlParams) -> ControlParams:
+    """The same controller with the CPG's ankle drive removed (the reflex stays)."""
+    return replace(p, ankle_gain=0.0)
+
+
+def kernel_index(m) -> np.ndarray:
+    """Addresses in MjData that the kernel reads (layout ``kernel.IX_*``); m: mujoco.MjModel."""
+    def named(kind, name):
+        try:
+            return getattr(m, kind)(name)
+        except KeyError:
+            raise InputError(f"the model has no {kind} named {name!r}, which the controller "
+                             f"needs") from None
+
+    jq = lambda n: m.jnt_qposadr[named("joint", n).id]  # noqa: E731
+    jv = lambda n: m.jnt_dofadr[named("joint", n).id]  # noqa: E731
+    sa = lambda n: m.sensor_adr[named("sensor", n).id]  # noqa: E731
+    body_floor = [sa(f"{b}_floor") for b in BODY_FLOOR_SENSORS]
+    if body_floor != list(range(body_floor[0], body_floor[0] + len(body_floor))):
+        raise InputError("the body-floor contact sensors must be consecutive in the MJCF")
+    ix = np.zeros(kernel.IX_SIZE, dtype=np.int64)
+    for i, leg in enumerate(("left", "right")):
+        ix[kernel.IX_HIP_Q + i], ix[kernel.IX_HIP_V + i] = jq(f"{leg}_hip"), jv(f"{leg}_hip")
+        ix[kernel.IX_KNEE_Q + i], ix[kernel.IX_KNEE_V + i] = jq(f"{leg}_knee"), jv(f"{leg}_knee")
+        ix[kernel.IX_FORCE + i] = sa(f"{leg}_foot_contact") + 3  # found, then force x y z: normal
+        ix[kernel.IX_FOOT + i] = named("body", f"{leg}_foot").id
+        for j, name in enumerate(("hip", "knee", "ankle")):
+            ix[kernel.IX_JOINTS + 3 * i + j] = jq(f"{leg}_{name}")
+    ix[kernel.IX_ROOTY_Q], ix[kernel.IX_ROOTY_V] = jq("rooty"), jv("rooty")
+    ix[kernel.IX_COM], ix[kernel.IX_COMVEL] = sa("com_pos"), sa("com_vel")
+    ix[kernel.IX_TORSO] = named("body", "torso").id
+    ix[kernel.IX_BODY_FLOOR], ix[kernel.IX_N_BODY_FLOOR] = body_floor[0], len(body_floor)
+    return ix
+
+
+# Bodies whose touching the floor is a fall (contact sensors "<body>_floor" in biped.xml).
+BODY_FLOOR_SENSORS = ("torso", "left_thigh", "left_shank", "right_thigh", "right_shank")
+
+
+class CPGController:
+    """Maps the CPG (open loop: its schedule; closed loop: the network stepped here, reading
+    the body's sensors, :mod:`cpg.feedback`) and the body state to the 8 actuator controls.
+
+    A thin holder of the compiled kernel's inputs (:func:`cpgbiped.envs.control.control_kernel.control`): the
+    MjData views are taken once, so a call costs one kernel dispatch. model, data: the raw
+    ``mujoco.MjModel`` / ``mujoco.MjData`` (a dm_control Physics' ``model.ptr``, ``data.ptr``).
+    Closed loop (``loop`` given, ``schedule`` None), every call is one control tick of
+    ``loop``'s tick length: the network advances by one tick before the controls are formed.
+    """
+
+    def __init__(self, model, data, schedule: CPGSchedule | None, params: ControlParams = CONTROL,
+                 loop=None):
+        if (schedule is None) == (loop is None):
+            raise InputError("a controller needs either a CPG schedule (open loop) or a network "
+                             "to step (closed loop)")
+        self.p = params
+        self.sched = schedule
+        self.loop = loop
+        self.P = params_array(params)
+        self.S = kernel.new_state()
+        self.ix = kernel_index(model)
+        d = data
+        self.views = (d.qpos, d.qvel, d.sensordata, d.xpos)
+        self.u = np.zeros(8)
+        self.last_v = np.zeros(4)
+        self.last_a = np.zeros(4)
+        # closed loop: the sensors held over a tick, the feedback terms, work space
+        self.weight_n = float(model.body_subtreemass[0] * np.linalg.norm(model.opt.gravity))
+        from cpgbiped.cpg.feedback import N_SENSORS
+
+        self.sensors = np.zeros(N_SENSORS)
+        self.fb = np.zeros(4)
+        self.scratch = np.zeros((6, 24))
+        self.ticks = 0
+
+    @property
+    def modes(self) -> np.ndarray:
+        """(2,) leg modes (kernel.MODE_SUPPORT, MODE_LIFT, MODE_AIR) of the last tick."""
+        return self.S[kernel.S_MODE:kernel.S_MODE + 2].copy()
+
+    @property
+    def feedback(self) -> np.ndarray:
+        """(4,) the feedback term each cell received at the last tick (zero open loop)."""
+        return self.fb.copy()
+
+    def __call__(self, t_s: float) -> np.ndarray:
+        """The 8 controls at time t_s (s): LF, RF, LE, RE muscles, then hip and knee torques."""
+        qpos, qvel, sens, xpos = self.views
+        if self.loop is None:
+            kernel.control(t_s, self.sched.v, self.sched.a, self.sched.dt_s, self.P, self.S,
+                           qpos, qvel, sens, xpos, self.ix, self.u, self.last_v, self.last_a)
+            return self.u
+        L = self.loop
+        ok = kernel.step_closed(self.ticks > 0, L.code, L.P, L.P_ab, L.knots, L.y, L.gain,
+                                L.n_sub, L.h, L.noise, (self.ticks - 1) * L.n_sub, L.act_centre,
+                                L.act_width, self.weight_n, L.tick_s, self.sensors, self.fb,
+                                self.scratch, t_s, self.P, self.S, qpos, qvel, sens, xpos,
+                                self.ix, self.u, self.last_v, self.last_a)
+        self.ticks += 1
+        if not ok:
+            raise InputError("the network's state left its range under feedback: lower the gain")
+        return self.u

@@ -1,0 +1,116 @@
+"""Secondary gaits in the body: every weight set that ``cpgbiped secondary`` found, through the
+one controller.
+
+Each target of a secondary results file (format ``cpg.results.SECONDARY_FORMAT``) is a
+Morris-Lecar network: its 12 directed weights, I_app and phi, started from the Table 3 state of
+the primary gait it was broken from. It drives the body for ``seconds`` after the settling
+window; the CPG classifier names the gait of the cells, the contact classifier (primary
+patterns, then the secondary ones of :data:`cpgbiped.envs.gaits.criteria.SECONDARY_PATTERNS`) the gait of the
+body. A target is confirmed physically when both name it and the body does not fall.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.morris_lecar import DIRECTED_NAMES, PRIMARY_GAITS
+from cpgbiped.cpg.results import SECONDARY_FORMAT
+
+KEYS = ("physical_gait", "cpg_gait", "fell", "fell_at_s", "duty_factor", "lr_phase_lag",
+        "flight", "double_support", "stride_period_s", "speed_mps", "footfalls_per_stride")
+MAX_TARGETS = 64
+
+
+def load_secondary(path) -> list[dict]:
+    """The targets of a secondary results file, each checked before any rollout."""
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text())
+    except FileNotFoundError:
+        raise InputError(f"secondary results file {str(p)!r} does not exist") from None
+    except (OSError, ValueError, RecursionError) as e:
+        raise InputError(f"secondary results file {str(p)!r} is not readable JSON: "
+                         f"{type(e).__name__}") from None
+    if not isinstance(data, dict) or data.get("format") != SECONDARY_FORMAT:
+        raise InputError(f"{str(p)!r} is not a cpgbiped secondary results file (format "
+                         f"{SECONDARY_FORMAT})")
+    targets = data.get("targets")
+    if not isinstance(targets, list) or not 1 <= len(targets) <= MAX_TARGETS:
+        raise InputError(f"{str(p)!r}: 'targets' must be a list of 1-{MAX_TARGETS} entries")
+    out = []
+    for k, t in enumerate(targets):
+        try:
+            name, source = t["target"], t["source"]
+            w = t["directed_weights"]
+            if not isinstance(name, str) or source not in PRIMARY_GAITS:
+                raise ValueError("target/source")
+            if not isinstance(w, dict) or set(w) != set(DIRECTED_NAMES):
+                raise ValueError("directed_weights must name the 12 directed weights")
+            vals = [w[n] for n in DIRECTED_NAMES] + [t["i_app"], t["phi"]]
+            if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in vals):
+                raise ValueError("weights, i_app and phi must be numbers")
+            if not np.all(np.isfinite(vals)) or t["phi"] <= 0:
+                raise ValueError("weights, i_app and phi must be finite, phi > 0")
+        except (KeyError, TypeError, ValueError) as e:
+            raise InputError(f"{str(p)!r}: target {k} is malformed ({e})") from None
+        out.append({"target": name, "source": source, "weights": vals[:12],
+                    "i_app": float(t["i_app"]), "phi": float(t["phi"]),
+                    "found": bool(t.get("found", False))})
+    return out
+
+
+def _one(args):
+    t, seconds = args
+    from cpgbiped.cpg.network import build
+
+    from cpgbiped.envs.gaits.validate import validate
+
+    net = build("ml", t["source"], weights=t["weights"], i_app=t["i_app"], phi=t["phi"])
+    try:
+        net.period()
+    except InputError as e:
+        return {"source": t["source"], "found_in_network": t["found"], "error": str(e),
+                "cpg_gait": "none", "physical_gait": "none", "fell": None, "confirmed": False}
+    s = validate(net, None, seconds).summary()
+    row = {"source": t["source"], "found_in_network": t["found"], **{k: s[k] for k in KEYS}}
+    row["confirmed"] = bool(s["cpg_gait"] == t["target"] == s["physical_gait"] and not s["fell"])
+    return row
+
+
+def check_secondary(path, seconds: float = 20.0, workers: int = 2) -> dict:
+    """{"<target> from <source>": {cpg_gait, physical_gait, fell, confirmed, metrics}}."""
+    targets = load_secondary(path)
+    jobs = [(t, seconds) for t in targets]
+    if workers > 1 and len(jobs) > 1:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(min(workers, len(jobs)),
+                                 mp_context=multiprocessing.get_context("spawn")) as ex:
+            rows = list(ex.map(_one, jobs))
+    else:
+        rows = [_one(j) for j in jobs]
+    out = {}
+    for t, r in zip(targets, rows):
+        key = t["target"] if t["target"] not in out else f"{t['target']} from {t['source']}"
+        if key in out or any(k.startswith(t["target"]) for k in out):
+            key = f"{t['target']} from {t['source']}"
+        out[key] = r
+    return out
+
+
+def table(res: dict) -> str:
+    from cpgbiped.cpg.io import format_table
+
+    rows = []
+    for name, r in res.items():
+        f = lambda x: "-" if x is None or not np.isfinite(x) else f"{x:.2f}"  # noqa: E731
+        rows.append([name, "yes" if r["found_in_network"] else "no", r["cpg_gait"],
+                     r["physical_gait"], "-" if r["fell"] is None else ("yes" if r["fell"] else "no"),
+                     f(r.get("lr_phase_lag")), f(r.get("flight")),
+                     "CONFIRMED" if r["confirmed"] else "-"])
+    return format_table(rows, ["target", "found in network", "cpg", "physical", "fell",
+                               "L-R lag", "flight", "in the body"])

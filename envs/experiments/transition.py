@@ -1,0 +1,100 @@
+"""Gait transitions in physics: the network's parameters change in mid-run and the body follows.
+
+The network starts as preset A (its Table 3 state) and, at ``at_s`` (simulation time from the
+start, settling included), its parameters move to preset B's: a step (ramp 0) or a linear ramp
+over ``ramp_s`` seconds (:class:`cpg.integrate.Schedule`). The CPG's state carries across the
+change; nothing is reset, and the controller is not told (it never sees a name).
+
+Windows, all measured from the foot contacts (:func:`cpgbiped.envs.gaits.validate.measure_recording`):
+- **before**: from the end of the settling window to the change;
+- **sliding**: ``WINDOW_CYCLES`` CPG cycles of B starting 0, 1, 2, ... cycles after the change
+  began, while such a window fits in the rollout;
+- **after**: from the first sliding window from which every later one names the same physical
+  gait (the gait has settled) to the end. ``cycles_to_switch``: the CPG cycles (of B) from the
+  change to the start of that window when the settled gait is B; None when B never settles.
+
+With the closed loop (``feedback`` K > 0; Morris-Lecar) the network is stepped with the body
+through the change.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import PRESETS, build
+
+from cpgbiped.envs.gaits.criteria import SETTLE_S
+from cpgbiped.envs.simulation.rollout import check_seconds, rollout
+from cpgbiped.envs.gaits.validate import measure_recording
+
+WINDOW_CYCLES = 3  # CPG cycles of the target per sliding window
+KEYS = ("physical_gait", "cpg_gait", "fell", "duty_factor", "lr_phase_lag", "double_support",
+        "flight", "stride_period_s", "speed_mps", "froude", "apex_height_m")
+
+
+def check_transition(kind: str, a: str, b: str, at_s: float, ramp_s: float, seconds: float):
+    if kind not in PRESETS:
+        raise InputError(f"unknown network {kind!r}: use ml or hopf")
+    if kind == "matsuoka":
+        raise InputError("the Matsuoka network has one preset: it has no transition")
+    for name, g in (("--from", a), ("--to", b)):
+        if g not in PRESETS[kind]:
+            raise InputError(f"{name}: unknown {kind} gait {g!r}: use {', '.join(PRESETS[kind])}")
+    seconds = check_seconds(seconds)
+    if not (np.isfinite(ramp_s) and ramp_s >= 0):
+        raise InputError(f"--ramp must be a number of seconds >= 0, got {ramp_s}")
+    if not (np.isfinite(at_s) and SETTLE_S < at_s and at_s + ramp_s < seconds):
+        raise InputError(f"--at {at_s:g} s (plus the ramp {ramp_s:g} s) lies outside the rollout: "
+                         f"the change must come after the {SETTLE_S:g} s settling and end "
+                         f"before {seconds:g} s")
+    return seconds
+
+
+def _window(net, rec, t0, t1, fell_at):
+    """Summary of [t0, t1] with the fall counted only when it lies inside."""
+    inside = fell_at is not None and fell_at <= (np.inf if t1 is None else t1)  # fell by its end
+    r = replace(rec, fell_at=fell_at if inside else None)
+    s = measure_recording(net, None, r, t0, t_end=t1).summary()
+    return {k: s.get(k) for k in KEYS} | {"start_s": float(t0),
+                                          "end_s": float(rec.t[-1] if t1 is None else t1)}
+
+
+def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0,
+               seconds: float = 20.0, feedback: float = 0.0, poses: bool = False):
+    """(result dict, recording, the network A, the network B)."""
+    seconds = check_transition(kind, a, b, at_s, ramp_s, seconds)
+    net, to = build(kind, a), build(kind, b)
+    rec = rollout(net, seconds, to=to, change=Schedule.change(at_s, ramp_s), poses=poses,
+                  stop_on_fall=False, feedback=feedback)
+    fell_at = rec.fell_at
+    T = to.period_s()
+    before = _window(net, rec, SETTLE_S, at_s, fell_at)
+    slides = []
+    k = 0
+    while at_s + (k + WINDOW_CYCLES) * T <= rec.t[-1] + 1e-9:
+        t0 = at_s + k * T
+        slides.append(_window(to, rec, t0, t0 + WINDOW_CYCLES * T, fell_at))
+        k += 1
+    settled = None
+    names = [w["physical_gait"] for w in slides]
+    for i in range(len(names)):
+        if len(names) - i >= 2 and all(n == names[i] for n in names[i:]):
+            settled = i
+            break
+    start = at_s + (settled if settled is not None else len(slides)) * T
+    after = _window(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
+    res = {"network": kind, "from": a, "to": b, "at_s": float(at_s), "ramp_s": float(ramp_s),
+           "seconds": seconds, "feedback_gain": rec.feedback_gain, "cpg_period_to_s": T,
+           "before": before, "after": after, "fell": fell_at is not None,
+           "fell_at_s": fell_at,
+           "settled_after_cycles": settled,
+           "cycles_to_switch": (settled if settled is not None and names[settled] == b
+                                and fell_at is None else None),
+           "windows": [{"start_s": w["start_s"], "physical_gait": w["physical_gait"]}
+                       for w in slides]}
+    res["switched"] = bool(res["cycles_to_switch"] is not None
+                           and before["physical_gait"] == a and not res["fell"])
+    return res, rec, net, to

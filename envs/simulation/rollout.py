@@ -1,0 +1,234 @@
+"""Rollouts: a network drives the biped through the one controller; the state is recorded.
+
+Seconds everywhere (simulation time from the start of the rollout). The network starts from
+its initial state when the body starts (t = 0); the body starts standing still.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.feedback import check_gain, loop_network
+from cpgbiped.cpg.integrate import Schedule
+from cpgbiped.cpg.network import Network
+from cpgbiped.models import BIPED_SCENE
+
+from cpgbiped.envs.control import control_kernel as kernel
+from cpgbiped.envs.simulation.biped import load_model, scale_friction
+from cpgbiped.envs.control.controller import CONTROL, ControlParams, CPGController, cpg_schedule, without_ankle_drive
+
+FALL_HEIGHT = 0.55  # torso (hip) height below which the biped has fallen (m); standing 0.86
+FALL_PITCH = 1.0  # |torso pitch| above which it has fallen (rad)
+# Any body other than a foot touching the floor (a knee, a shank, the torso) is a fall too.
+MAX_SECONDS = 600.0  # longest rollout (simulated s): bounds memory and time
+CONTROL_EVERY = 2  # physics steps per control tick (2 ms each: a 4 ms control period)
+
+
+@dataclass
+class Recording:
+    """A rollout sampled at every control tick (seconds)."""
+
+    t: np.ndarray  # (T,)
+    contact: np.ndarray  # (T, 2) raw foot contact
+    force: np.ndarray  # (T, 2) normal force (N)
+    cpg_v: np.ndarray  # (T, 4) cell outputs LF, RF, LE, RE
+    drive: np.ndarray  # (T, 4) the CPG's activations (the controller's input)
+    activation: np.ndarray  # (T, 4) ankle muscle activation state
+    joints: np.ndarray  # (T, 6) rad
+    torso_height: np.ndarray
+    torso_pitch: np.ndarray
+    com_x: np.ndarray
+    com_z: np.ndarray
+    modes: np.ndarray  # (T, 2) leg modes (kernel.MODE_*)
+    ctrl: np.ndarray  # (T, 8) controls sent
+    power: np.ndarray  # (T, 8) actuator power, force x velocity (W), actuator order
+    dt: float  # sample interval (s)
+    physics_dt: float
+    fell_at: float | None = None
+    unstable: str | None = None
+    qpos: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (T, nq)
+    body_pose: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 7)))  # (T, nbody, 7)
+    xml_path: str = str(BIPED_SCENE)  # the model the rollout ran (renderers, rerun)
+    feedback: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # (T, 4) per cell
+    feedback_gain: float = 0.0  # K of cpg.feedback (0: open loop)
+
+
+def check_seconds(seconds: float, name: str = "seconds") -> float:
+    if not (isinstance(seconds, (int, float, np.floating)) and np.isfinite(seconds)
+            and 0 < seconds <= MAX_SECONDS):
+        raise InputError(f"{name} must be a number in (0, {MAX_SECONDS:g}] s, got {seconds}")
+    return float(seconds)
+
+
+def check_push(push, seconds: float):
+    """(time s, impulse N s) inside the rollout, or None."""
+    if push is None:
+        return None
+    t, imp = (float(x) for x in push)
+    if not (np.isfinite(t) and np.isfinite(imp)):
+        raise InputError(f"--push needs finite numbers, got {t} {imp}")
+    if not 0 <= t < seconds:
+        raise InputError(f"--push time {t:g} s lies outside the rollout [0, {seconds:g}) s "
+                         f"(simulation time from the start, settling included)")
+    if not abs(imp) < 1e4:
+        raise InputError(f"--push impulse must be below 1e4 N s in size, got {imp:g}")
+    return (t, imp)
+
+
+def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *,
+            friction_scale: float = 1.0, push: tuple[float, float] | None = None,
+            stop_on_fall: bool = True, ankle_drive: bool = True,
+            to: Network | None = None, change: Schedule | None = None,
+            xml_path: str | Path = BIPED_SCENE, poses: bool = True,
+            feedback: float = 0.0, feedback_form: str | None = None) -> Recording:
+    """Run the CPG-driven biped for ``seconds`` of simulated time.
+
+    Every tick records the joint positions and every body's world pose (forward kinematics of
+    those positions). stop_on_fall=False keeps going after a fall (videos show it).
+    push: (time s, impulse N s) horizontal impulse on the torso. ankle_drive=False removes the
+    CPG's ankle drive (the reflexes stay). to, change: the network's parameters move towards
+    ``to``'s along ``change`` (knot times in seconds). poses=False skips the joint positions
+    and body poses (``qpos``, ``body_pose`` stay empty): searches that only need the metrics
+    save the forward kinematics of every tick. feedback: the gain K of the body's feedback
+    into the CPG (:mod:`cpg.feedback`); 0 (default) integrates the network ahead, open loop,
+    as the paper does; K > 0 steps it tick by tick with the sensors.
+    """
+    seconds = check_seconds(seconds)
+    push = check_push(push, seconds)
+    K = 0.0 if feedback == 0 else check_gain(network.kind, feedback)  # any Network open loop
+    if (to is None) != (change is None):
+        raise InputError("a parameter change needs both the target network and a schedule")
+    if not ankle_drive:
+        params = without_ankle_drive(params)
+    m = load_model(xml_path)
+    if friction_scale != 1.0:
+        scale_friction(m, friction_scale)
+    d = mujoco.MjData(m)
+    dt = m.opt.timestep
+    if K > 0:
+        ctrl = CPGController(m, d, None, params,
+                             loop=loop_network(network, K, dt * CONTROL_EVERY, seconds,
+                                               feedback_form, to, change))
+    else:
+        ctrl = CPGController(m, d, cpg_schedule(network, seconds, to=to, change=change), params)
+    n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))
+    rec = np.zeros((n_ticks, kernel.R_SIZE))
+    qpos_rec = np.zeros((n_ticks if poses else 0, m.nq))
+    pose_rec = np.zeros((n_ticks if poses else 0, m.nbody, 7))
+    # Poses from forward kinematics of the recorded qpos (after mj_step, MjData's own xpos is
+    # that of the state before the last integration), on a second MjData the controller never
+    # reads.
+    dk = mujoco.MjData(m)
+    qk, xk, qk_rot = dk.qpos, dk.xpos, dk.xquat
+    fell, unstable, n = None, None, 0
+    torso_id = m.body("torso").id
+    qpos, sens, xpos, act, ctrl_in = d.qpos, d.sensordata, d.xpos, d.act, d.ctrl
+    afrc, avel = d.actuator_force, d.actuator_velocity
+    ix, v, a, S = ctrl.ix, ctrl.last_v, ctrl.last_a, ctrl.S
+    bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
+    push_tick = None if push is None else int(round(push[0] / (dt * CONTROL_EVERY)))
+    P, qvel = ctrl.P, d.qvel
+    if K > 0:
+        L = ctrl.loop
+        loop_args = (L.code, L.P, L.P_ab, L.knots, L.y, L.gain, L.n_sub, L.h, L.noise,
+                     L.act_centre, L.act_width, ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb,
+                     ctrl.scratch)
+
+        def tick(k):
+            return kernel.tick_closed(k, d.time, *loop_args, P, S, qpos, qvel, sens, xpos, act,
+                                      ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
+    else:
+        sv, sa, sdt = ctrl.sched.v, ctrl.sched.a, ctrl.sched.dt_s
+
+        def tick(k):
+            return kernel.tick(k, d.time, sv, sa, sdt, P, S, qpos, qvel, sens, xpos, act,
+                               ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
+    if not poses:  # the whole loop compiled (envs.step_loop): the same rows, bit for bit
+        n, fell, unstable = _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec,
+                                           stop_on_fall)
+        return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path, K)
+    try:
+        # Tick k records row k - 1 (the state after the last steps) and sets the controls of
+        # tick k, in one compiled call (kernel.tick); the loop runs one extra tick for the
+        # last row.
+        for k in range(n_ticks + 1):
+            status = tick(k)
+            if k > 0:
+                if status == 2 or bad_qacc.number:
+                    unstable = f"physics became unstable at t={d.time:.3f} s"
+                    break
+                if poses:
+                    qk[:] = qpos
+                    mujoco.mj_kinematics(m, dk)
+                    kernel.record_pose(k - 1, qpos, xk, qk_rot, qpos_rec, pose_rec)
+                n = k
+                if status == 1 and fell is None:
+                    fell = float(d.time)
+                    if stop_on_fall:
+                        break
+            if k == n_ticks:
+                break
+            if k == push_tick:  # impulse = force x duration
+                d.xfrc_applied[torso_id, 0] = push[1] / (dt * CONTROL_EVERY)
+            mujoco.mj_step(m, d, nstep=CONTROL_EVERY)
+            if k == push_tick:
+                d.xfrc_applied[torso_id, 0] = 0.0
+    except mujoco.FatalError as e:
+        raise InputError(f"physics became unstable: {e}") from None
+    return _recording(rec[:n], dt, fell, unstable, qpos_rec[:n], pose_rec[:n], xml_path, K)
+
+
+COMPILED_CHUNK = 250  # ticks (1 s) between two looks at MuJoCo's warnings
+
+
+def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_fall):
+    """The tick loop of :func:`rollout` in compiled chunks; (rows, fell_at, unstable)."""
+    from cpgbiped.envs.simulation.step_loop import run_ticks, run_ticks_closed
+
+    dt = m.opt.timestep
+    bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
+    force = 0.0 if push is None else push[1] / (dt * CONTROL_EVERY)
+    args = (d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl, d.actuator_force,
+            d.actuator_velocity, ctrl.ix, ctrl.last_v, ctrl.last_a, rec, FALL_HEIGHT,
+            FALL_PITCH, -1 if push_tick is None else push_tick, force, d.xfrc_applied, torso_id)
+    k, n, fell = 0, 0, None
+    sched = ctrl.sched
+    while k <= n_ticks:
+        k_end = min(k + COMPILED_CHUNK, n_ticks + 1)
+        if ctrl.loop is None:
+            k_next, status = run_ticks(m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY,
+                                       d.time, dt, sched.v, sched.a, sched.dt_s, ctrl.P, ctrl.S,
+                                       *args)
+        else:
+            L = ctrl.loop
+            k_next, status = run_ticks_closed(
+                m._address, d._address, k, k_end, n_ticks, CONTROL_EVERY, d.time, dt, L.code,
+                L.P, L.P_ab, L.knots, L.y, L.gain, L.n_sub, L.h, L.noise, L.act_centre, L.act_width,
+                ctrl.weight_n, L.tick_s, ctrl.sensors, ctrl.fb, ctrl.scratch, ctrl.P, ctrl.S, *args)
+        if bad_qacc.number:  # somewhere in this chunk: keep the rows recorded before it
+            return max(k - 1, 0), fell, f"physics became unstable at t={d.time:.3f} s"
+        if status == 2:  # row k_next - 2 is not finite
+            return k_next - 2, fell, f"physics became unstable at t={d.time:.3f} s"
+        n = k_next - 1
+        if status == 1:
+            if fell is None:
+                fell = float(rec[n - 1, kernel.R_T])
+            if stop_on_fall:
+                return n, fell, None
+        k = k_next
+    return n, fell, None
+
+
+def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path,
+               gain: float = 0.0) -> Recording:
+    K = kernel
+    col = lambda a, n=1: r[:, a:a + n].copy() if n > 1 else r[:, a].copy()  # noqa: E731
+    return Recording(col(K.R_T), col(K.R_CONTACT, 2) > 0.5, col(K.R_FORCE, 2), col(K.R_V, 4),
+                     col(K.R_DRIVE, 4), col(K.R_ACT, 4), col(K.R_JOINTS, 6), col(K.R_HEIGHT),
+                     col(K.R_PITCH), col(K.R_COMX), col(K.R_COMZ), col(K.R_MODE, 2),
+                     col(K.R_CTRL, 8), col(K.R_POWER, 8), dt * CONTROL_EVERY, dt, fell, unstable,
+                     qpos, pose, str(xml_path), col(K.R_FB, 4), gain)

@@ -1,0 +1,248 @@
+"""Physical trials: a Morris-Lecar network under one condition, rolled out, measured.
+
+A :class:`Trial` is what a physics-in-the-loop search evaluates: the network's parameters
+(w_a, w_b, w_c, I_app, phi; the gait's Table 3 initial state, or a random one drawn from
+``cpg_seed``) and a condition (friction scale, a horizontal push on the torso). :func:`run_trial`
+rolls it out through the one controller, without the body poses a video needs, and returns
+the numbers a search scores (:class:`TrialResult`). Every trial is deterministic: the same
+trial gives the same result in any process, so a batch spread over processes or a Dask
+cluster gives the result of a serial loop.
+
+Runners (``runner(trials) -> list[TrialResult]``, in order):
+- :class:`PoolRunner`: worker processes on this machine (spawned: forking a parent that runs
+  OpenMP threads aborts the child), kept alive between batches;
+- :class:`DaskRunner`: a Dask ``LocalCluster`` or the scheduler at ``tcp://host:port``.
+"""
+from __future__ import annotations
+
+import math
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from cpgbiped.cpg.errors import InputError
+
+from cpgbiped.envs.gaits.criteria import SETTLE_S
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One rollout to score. ``preset``: the gait whose Table 3 state starts the network (and
+    whose parameters fill any left as None); ``push``: (time s, impulse N s) or None."""
+
+    preset: str
+    weights: tuple[float, float, float]
+    i_app: float
+    phi: float
+    cpg_seed: int | None = None
+    friction_scale: float = 1.0
+    push: tuple[float, float] | None = None
+    feedback: float = 0.0  # gain K of the body's feedback into the CPG (cpg.feedback)
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    """What one trial measured over its steady window (after ``settle_s``).
+
+    fell: the body fell, the physics became unstable, or the network could not drive it (then
+    ``error`` says why); survived_s: simulated seconds before that (the whole rollout if not);
+    physical_gait: the contact-only classifier's name; froude = v^2 / (g L);
+    cost_of_transport: positive actuator work / (m g distance), NaN for a gait in place;
+    work_per_stride_J: positive actuator work per stride.
+    """
+
+    fell: bool
+    survived_s: float
+    physical_gait: str
+    froude: float
+    speed_mps: float
+    cost_of_transport: float
+    work_per_stride_J: float
+    duty: float
+    flight: float
+    stride_period_s: float
+    apex_height_m: float
+    error: str | None = None
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def _failed(why: str) -> TrialResult:
+    nan = float("nan")
+    return TrialResult(True, 0.0, "none", nan, nan, nan, nan, nan, nan, nan, nan, why)
+
+
+def _num(x) -> float:
+    return float("nan") if x is None else float(x)
+
+
+def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
+              stop_on_fall: bool = True) -> TrialResult:
+    """Roll ``trial`` out for ``settle_s + seconds`` and measure the last ``seconds``."""
+    from cpgbiped.cpg.network import build
+
+    from cpgbiped.envs.simulation.rollout import rollout
+    from cpgbiped.envs.gaits.validate import measure_recording
+
+    total = settle_s + seconds
+    try:
+        net = build("ml", trial.preset, weights=list(trial.weights), i_app=trial.i_app,
+                    phi=trial.phi, seed=trial.cpg_seed)
+        rec = rollout(net, total, friction_scale=trial.friction_scale, push=trial.push,
+                      stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback)
+    except InputError as e:  # a network that diverges cannot drive the body
+        return _failed(str(e))
+    v = measure_recording(net, None, rec, settle_s)
+    m, b = v.metrics, v.biomech
+    fell = bool(m.fell) or rec.unstable is not None
+    survived = float(rec.t[-1]) if len(rec.t) else 0.0
+    return TrialResult(
+        fell=fell, survived_s=survived if fell else total, physical_gait=m.physical_gait,
+        froude=_num(b.froude), speed_mps=_num(m.speed_mps),
+        cost_of_transport=_num(b.cost_of_transport), work_per_stride_J=_num(b.work_per_stride_J),
+        duty=mean_finite([m.duty_factor["left"], m.duty_factor["right"]]),
+        flight=_num(m.flight), stride_period_s=_num(m.stride_period_s),
+        apex_height_m=_num(b.apex_height_m), error=rec.unstable)
+
+
+@dataclass(frozen=True)
+class ControlTrial:
+    """One rollout that scores controller gains (``cpgbiped tune``): the Morris-Lecar preset of
+    ``preset`` with its parameters, started from its Table 3 state or from a random one drawn
+    from ``cpg_seed``, driving the body through the controller whose parameter array
+    (:func:`cpgbiped.envs.control.controller.params_array`) is ``control``, under a condition (friction
+    scale, a push (time s, impulse N s))."""
+
+    preset: str
+    control: tuple
+    cpg_seed: int | None = None
+    friction_scale: float = 1.0
+    push: tuple[float, float] | None = None
+
+
+def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SETTLE_S,
+                      stop_on_fall: bool = True) -> dict:
+    """Roll ``trial`` out and return its summary (:meth:`envs.validate.Validation.summary`,
+    the gait named by ``preset``) plus ``survived_s`` (simulated seconds before a fall, the
+    whole rollout otherwise), ``total_s`` and ``cpg_period_s``."""
+    from cpgbiped.cpg.network import build
+
+    from cpgbiped.envs.control.controller import params_from_array
+    from cpgbiped.envs.simulation.rollout import rollout
+    from cpgbiped.envs.gaits.validate import measure_recording
+
+    total = settle_s + seconds
+    net = build("ml", trial.preset, seed=trial.cpg_seed)
+    rec = rollout(net, total, params_from_array(np.asarray(trial.control, float)),
+                  friction_scale=trial.friction_scale, push=trial.push,
+                  stop_on_fall=stop_on_fall, poses=False)
+    s = measure_recording(net, trial.preset, rec, settle_s).summary()
+    fell = bool(s["fell"]) or rec.unstable is not None
+    s["fell"] = fell
+    s["survived_s"] = (float(rec.t[-1]) if len(rec.t) else 0.0) if fell else total
+    s["total_s"] = total
+    return s
+
+
+def _run_chunk(args) -> list[TrialResult]:
+    """A worker's share of a batch. The network's integrator is parallel over its batch; a
+    trial integrates one network, and idle threads that spin would take the core from the
+    other worker's physics, so a worker keeps one thread."""
+    import numba
+
+    numba.set_num_threads(1)
+    trials, seconds, settle_s, stop_on_fall = args
+    return [run_control_trial(t, seconds, settle_s, stop_on_fall) if isinstance(t, ControlTrial)
+            else run_trial(t, seconds, settle_s, stop_on_fall) for t in trials]
+
+
+def chunks(n: int, n_workers: int, per_worker: int = 4) -> list[slice]:
+    """Contiguous slices of range(n): about ``per_worker`` per worker (small enough to balance
+    rollouts that stop early at a fall, large enough to amortise the dispatch)."""
+    k = max(1, min(n, n_workers * per_worker))
+    edges = np.linspace(0, n, k + 1).round().astype(int)
+    return [slice(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+
+
+class SerialRunner:
+    """Every trial in this process, one after another (the baseline of the benchmark)."""
+
+    workers = 1
+
+    def __init__(self, seconds: float, settle_s: float = SETTLE_S, stop_on_fall: bool = True):
+        self.args = (seconds, settle_s, stop_on_fall)
+
+    def __call__(self, trials: list[Trial]) -> list[TrialResult]:
+        return _run_chunk((list(trials), *self.args))
+
+    def close(self):
+        pass
+
+
+class PoolRunner(SerialRunner):
+    """Trials in ``workers`` spawned processes that live until :meth:`close`."""
+
+    def __init__(self, seconds: float, settle_s: float = SETTLE_S, stop_on_fall: bool = True,
+                 workers: int | None = None):
+        super().__init__(seconds, settle_s, stop_on_fall)
+        self.workers = int(workers or os.cpu_count() or 1)
+        if self.workers < 1:
+            raise InputError(f"workers must be at least 1, got {workers}")
+        self.pool = ProcessPoolExecutor(self.workers,
+                                        mp_context=multiprocessing.get_context("spawn"))
+
+    def __call__(self, trials: list[Trial]) -> list[TrialResult]:
+        trials = list(trials)
+        jobs = [(trials[s], *self.args) for s in chunks(len(trials), self.workers)]
+        try:
+            return [r for part in self.pool.map(_run_chunk, jobs) for r in part]
+        except BaseException:
+            self.terminate()
+            raise
+
+    def warm_up(self) -> None:
+        """Start every worker and compile its kernels (a short rollout each)."""
+        t = Trial("walk", (0.39, -0.681, 0.489), 0.229, 0.254)
+        list(self.pool.map(_run_chunk, [([t], 0.1, 0.1, True)] * self.workers))
+
+    def terminate(self) -> None:
+        for proc in list(getattr(self.pool, "_processes", {}).values()):
+            proc.terminate()
+        self.pool.shutdown(wait=False, cancel_futures=True)
+
+    def close(self):
+        self.pool.shutdown()
+
+
+class DaskRunner(SerialRunner):
+    """Trials on a Dask cluster: a ``LocalCluster`` of ``workers`` processes when ``address``
+    is None, else the scheduler at ``tcp://host:port``."""
+
+    def __init__(self, seconds: float, settle_s: float = SETTLE_S, stop_on_fall: bool = True,
+                 address: str | None = None, workers: int = 2):
+        super().__init__(seconds, settle_s, stop_on_fall)
+        from cpgbiped.cpg.optimize import connect_dask
+
+        self.client, self.cluster = connect_dask(address, workers)
+        self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+
+    def __call__(self, trials: list[Trial]) -> list[TrialResult]:
+        trials = list(trials)
+        jobs = [(trials[s], *self.args) for s in chunks(len(trials), self.workers)]
+        futures = self.client.map(_run_chunk, jobs, pure=False)
+        return [r for part in self.client.gather(futures) for r in part]
+
+    def close(self):
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def mean_finite(x) -> float:
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    return float(x.mean()) if len(x) else math.nan
