@@ -103,6 +103,10 @@ class ResultDir:
             raise InputError(f"another cpgbiped run is writing to {str(self.target)!r}; wait for "
                              f"it to finish or choose another --out") from None
         recover(self.target)
+        # Staging folders of a run killed outright (SIGKILL) are left behind; holding the lock,
+        # no live run can be using one: remove them.
+        for old in parent.glob(f".{self.target.name}.staging-*"):
+            shutil.rmtree(old, ignore_errors=True)
         self.staging = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.staging-", dir=parent))
         return self
 

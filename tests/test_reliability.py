@@ -3,6 +3,8 @@ bounded memory, and one line (never a traceback) for every bad input."""
 import hashlib
 import json
 import os
+import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -327,3 +329,114 @@ def test_broken_mjcf_message_keeps_the_line_number(tmp_path):
 
     # tinyxml names the line of the element left open (<body>, line 3)
     assert re.search(r"Line number=3\b", str(e.value)) and "\n" not in str(e.value)
+
+
+# -- SIGTERM, process groups, leftovers, worker bounds (issue 24) ------------------------------
+PHYS = ["optimize", "--physics", "--gait", "hop", "--pop", "4", "--gens", "3", "--seconds", "4",
+        "--trials", "0", "--workers", "2", "--quiet"]
+
+
+def _group_alive(pgid: int) -> bool:
+    try:
+        os.killpg(pgid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def _start(args, out):
+    return subprocess.Popen([sys.executable, "-m", "cpgbiped.envs.cli", *args, "--out", str(out)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            start_new_session=True)  # its own process group: workers included
+
+
+def test_sigterm_at_many_moments_of_a_physics_search(tmp_path):
+    """SIGTERM (what timeout, kill and CI send) at moments spread over an optimize --physics
+    run with two worker processes: exit 143 with one line, the target old (absent here) or
+    complete, no staging folder left, no process of the run left; the next run succeeds."""
+    out = tmp_path / "phys"
+    t0 = time.perf_counter()
+    p = _start(PHYS, out)
+    assert p.wait(timeout=300) == 0, p.stderr.read()
+    total = time.perf_counter() - t0
+    done = sorted(f.name for f in out.iterdir())
+    terminated = 0
+    for frac in (0.3, 0.5, 0.7, 0.9):
+        shutil.rmtree(out, ignore_errors=True)
+        p = _start(PHYS, out)
+        time.sleep(frac * total)
+        p.send_signal(signal.SIGTERM)
+        p.wait(timeout=60)
+        err = p.stderr.read().decode().strip().splitlines()
+        deadline = time.time() + 10
+        while _group_alive(p.pid) and time.time() < deadline:
+            time.sleep(0.1)
+        assert not _group_alive(p.pid), f"a process of the run survived SIGTERM at {frac}"
+        if p.returncode != 0:
+            assert p.returncode == 143 and err == ["cpgbiped: terminated"], (p.returncode, err)
+            terminated += 1
+        # the target: untouched (absent here) or complete (the signal came after the commit)
+        assert not out.exists() or sorted(f.name for f in out.iterdir()) == done
+        assert not list(tmp_path.glob(".phys.staging-*"))
+    assert terminated >= 2
+    assert _start(PHYS, out).wait(timeout=300) == 0
+
+
+def test_a_terminals_ctrl_c_prints_one_line(tmp_path):
+    """Ctrl-C in a terminal signals the whole process group, workers included: the workers
+    stay quiet and the parent prints one line."""
+    out = tmp_path / "phys"
+    p = _start(PHYS, out)
+    time.sleep(2.5)
+    os.killpg(p.pid, signal.SIGINT)
+    p.wait(timeout=60)
+    err = p.stderr.read().decode().strip().splitlines()
+    if p.returncode != 0:
+        assert p.returncode == 130 and err == ["cpgbiped: interrupted"], err
+    deadline = time.time() + 10
+    while _group_alive(p.pid) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not _group_alive(p.pid)
+
+
+def test_staging_folders_of_a_killed_run_are_cleaned_by_the_next(tmp_path):
+    out = tmp_path / "phys"
+    left = tmp_path / ".phys.staging-killed"
+    left.mkdir()
+    (left / "half.json").write_text("{")
+    assert _start(PHYS, out).wait(timeout=300) == 0
+    assert not left.exists() and (out / "hop_physics.json").exists()
+
+
+@pytest.mark.parametrize("cmd", [["optimize", "--physics", "--gait", "hop"], ["matrix"],
+                                 ["tune", "--gait", "walk"]])
+def test_workers_are_bounded_by_the_cores(tmp_path, cmd):
+    n = (os.cpu_count() or 1) + 1
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *cmd, "--workers", str(n)]
+                       + (["--out", str(tmp_path / "o")] if cmd[0] != "matrix" else []),
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "cores" in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("args,says", [
+    (["reproduce", "--dt", "1e-7"], "[0.001, 0.1]"),
+    (["reproduce", "--dt", "1e-300"], "[0.001, 0.1]"),
+    (["optimize", "--gait", "walk", "--robustness-objective", "100000"], "at most 256"),
+])
+def test_sizes_that_multiply_time_or_memory_are_bounded(args, says):
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0]
+
+
+def test_secondary_results_that_do_not_exist_are_refused(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "secondary", "--results",
+                        str(tmp_path / "missing"), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "is not a folder" in r.stderr
+    assert not (tmp_path / "o").exists()

@@ -87,6 +87,18 @@ def seed_arg(text: str) -> int:
     return v
 
 
+def check_workers(a) -> None:
+    """--workers at most this machine's cores (more only multiplies memory, about 200 MB a
+    process, and slows the run), unless a Dask scheduler's address spreads them elsewhere."""
+    n = getattr(a, "workers", None)
+    dask = getattr(a, "dask", None)
+    cores = os.cpu_count() or 1
+    if n is not None and n > cores and (dask is None or dask == "local"):
+        raise _input_error(f"--workers {n} is more than this machine's {cores} cores (each "
+                           f"worker is a process of about 200 MB); use at most {cores}, or "
+                           f"--dask tcp://HOST:PORT for a cluster")
+
+
 def feedback_arg(text: str) -> float:
     """A feedback gain K >= 0 (its upper bound depends on the network: checked later)."""
     if text == "recommended":  # --feedback without a value (argparse passes const through)
@@ -107,6 +119,22 @@ def feedback_gain(a, kind: str) -> float:
     if k is None:
         return 0.0
     return check_gain(kind, RECOMMENDED[kind] if k == "recommended" else k)
+
+
+MAX_ROBUSTNESS_STATES = 256  # --robustness-objective: random states per individual
+
+
+def dt_arg(text: str) -> float:
+    return _number(text, 1e-3, 0.1, False, "must be an RK4 step in [0.001, 0.1] model units")
+
+
+def bounded_count_arg(lo: int, hi: int):
+    def parse(text: str) -> int:
+        v = count_arg(lo)(text)
+        if v > hi:
+            raise argparse.ArgumentTypeError(f"must be at most {hi}, got {v}")
+        return v
+    return parse
 
 
 def count_arg(lo: int):
@@ -279,6 +307,7 @@ def cmd_optimize_physics(a) -> int:
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
+    check_workers(a)
     gait = check_gait(a.gait)
     if a.robustness_objective or a.lock_time_objective or a.bounds != [-1.0, 1.0]:
         raise _input_error("--robustness-objective, --lock-time-objective and --bounds belong "
@@ -323,6 +352,7 @@ def cmd_tune(a) -> int:
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
+    check_workers(a)
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
                             a.conditions, a.sigma)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
@@ -421,6 +451,9 @@ def cmd_secondary(a) -> int:
     from cpgbiped.cpg.outdir import ResultDir
     from cpgbiped.cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
+    if a.results is not None and not os.path.isdir(a.results):
+        raise _input_error(f"--results {a.results!r} is not a folder of optimiser results")
+    a.results = a.results or "out/optimize"
     out_dir(a.out)
     rs = RunSettings(a.pop, a.gens, a.seed)
     primary, weights = {}, {}
@@ -573,6 +606,7 @@ def cmd_matrix(a) -> int:
     from cpgbiped.envs.gaits.matrix import matrix, matrix_table
 
     K = feedback_gain(a, a.network)
+    check_workers(a)
     res = matrix(a.network, seconds=a.seconds, seed=a.seed, workers=a.workers, feedback=K)
     if a.json:
         print(io.to_json(res))
@@ -588,6 +622,7 @@ def cmd_check_pareto(a) -> int:
     from cpgbiped.envs.search.pareto import check_pareto
 
     out_dir(a.out)
+    check_workers(a)
     out_file(a.rrd, "--rrd", ".rrd")
     res = check_pareto(a.result, a.out, first=a.first, seconds=a.seconds, render=a.render,
                        rrd=a.rrd, workers=a.workers, progress=not a.quiet)
@@ -749,6 +784,7 @@ def cmd_check_secondary(a) -> int:
     from cpgbiped.envs.experiments.secondary_check import check_secondary, load_secondary, table
 
     n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
+    check_workers(a)
     res = check_secondary(a.secondary, a.seconds, a.workers)
     if a.json:
         print(io.to_json(res))
@@ -1002,7 +1038,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--plot", action="store_true",
                     help="write the steady-state signals (PNG) to --out")
     sp.add_argument("--out", default="out", help="folder for --plot (default: out)")
-    sp.add_argument("--dt", type=float, default=0.02, help="RK4 step, model units (default 0.02)")
+    sp.add_argument("--dt", type=dt_arg, default=0.02,
+                    help="RK4 step, model units in [0.001, 0.1] (default 0.02)")
 
     sp = add("matsuoka", cmd_matsuoka, "the 12-neuron Matsuoka network: printed vs calibrated",
              """\
@@ -1062,9 +1099,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help="checkpoint interval in generations (default 5)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",
                     help="evaluate on Dask: a LocalCluster, or the scheduler at tcp://host:port")
-    sp.add_argument("--robustness-objective", type=count_arg(0), default=0, metavar="N",
+    sp.add_argument("--robustness-objective", type=bounded_count_arg(0, MAX_ROBUSTNESS_STATES),
+                    default=0, metavar="N",
                     help="add the objective 1 - fraction of N random initial states reaching "
-                         "the gait (N+1 integrations per individual)")
+                         f"the gait (N+1 integrations per individual; N <= "
+                         f"{MAX_ROBUSTNESS_STATES})")
     sp.add_argument("--lock-time-objective", action="store_true",
                     help="add the objective: model time until the phases stay within 2 deg")
     sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
@@ -1129,8 +1168,9 @@ def build_parser() -> argparse.ArgumentParser:
         one-legged hop). Each best point is re-simulated from the Table 3 state and 10 random
         states; "found" needs the classifier to name the target from the Table 3 state and
         from at least 80% of all states. Writes DIR/secondary.json and DIR/comparison.md.""")
-    sp.add_argument("--results", default="out/optimize",
-                    help="folder with <gait>.json optimiser results (default out/optimize)")
+    sp.add_argument("--results", default=None,
+                    help="folder with <gait>.json optimiser results (default out/optimize when "
+                         "it exists; the paper's weights for any gait without one)")
     sp.add_argument("--pop", type=count_arg(4), default=40, help="population size (default 40)")
     sp.add_argument("--gens", type=count_arg(1), default=30, help="generations per target (default 30)")
     sp.add_argument("--seed", type=seed_arg, default=0)
@@ -1155,9 +1195,33 @@ def build_parser() -> argparse.ArgumentParser:
 GL_BACKENDS = ("osmesa", "egl", "glfw")
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where Ctrl-C would be, so that it takes the same clean-up paths
+    (staging folders removed, worker pools and Dask clusters shut down)."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; every failure is one line on stderr: exit 2 for bad input, 1 for
-    anything unexpected ("internal error"; the traceback only with --debug), 130 on Ctrl-C."""
+    anything unexpected ("internal error"; the traceback only with --debug), 130 on Ctrl-C,
+    143 on SIGTERM (handled like Ctrl-C)."""
+    import signal
+    import threading
+
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        return _main(argv)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str] | None) -> int:
     from cpgbiped.cpg.errors import InputError
 
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -1175,6 +1239,9 @@ def main(argv: list[str] | None = None) -> int:
         return e.code if isinstance(e.code, int) else 0
     except InputError as e:
         return _fail(str(e))
+    except Terminated:
+        print("cpgbiped: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("cpgbiped: interrupted", file=sys.stderr)
         return 130
@@ -1197,6 +1264,7 @@ def run() -> int:
 
     code = main()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     return code
 
 

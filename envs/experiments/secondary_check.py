@@ -88,8 +88,11 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2) -> dict:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
+        from cpgbiped.envs.simulation.trials import quiet_worker
+
         with ProcessPoolExecutor(min(workers, len(jobs)),
-                                 mp_context=multiprocessing.get_context("spawn")) as ex:
+                                 mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=quiet_worker) as ex:
             rows = list(ex.map(_one, jobs))
     else:
         rows = [_one(j) for j in jobs]

@@ -52,7 +52,10 @@ def matrix(kind: str = "ml", seconds: float = 20.0, seed: int | None = None,
         # spawn, not fork: the parent may already run GNU OpenMP threads (numba, BLAS), and
         # forking such a process aborts the child.
         ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=ctx) as ex:
+        from cpgbiped.envs.simulation.trials import quiet_worker
+
+        with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=ctx,
+                                 initializer=quiet_worker) as ex:
             rows = list(ex.map(_row, jobs))
     return {"network": kind, "seed": seed, "seconds": seconds, "feedback_gain": feedback,
             "rows": dict(zip(PRESETS[kind], rows))}

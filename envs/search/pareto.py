@@ -37,8 +37,11 @@ def _pool_map(fn, jobs, workers: int, progress: bool, desc: str):
     from tqdm import tqdm
 
     # spawn: forking a parent that already runs OpenMP threads aborts the child
+    from cpgbiped.envs.simulation.trials import quiet_worker
+
     ex = ProcessPoolExecutor(min(workers, len(jobs)),
-                             mp_context=multiprocessing.get_context("spawn"))
+                             mp_context=multiprocessing.get_context("spawn"),
+                             initializer=quiet_worker)
     try:
         futures = [ex.submit(fn, j) for j in jobs]
         out = []

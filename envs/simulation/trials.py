@@ -71,6 +71,14 @@ class TrialResult:
         return asdict(self)
 
 
+def quiet_worker() -> None:
+    """A worker process ignores Ctrl-C: a terminal's Ctrl-C reaches the whole process group,
+    and the parent alone reports it (one line) and shuts the workers down."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _failed(why: str) -> TrialResult:
     nan = float("nan")
     return TrialResult(True, 0.0, "none", nan, nan, nan, nan, nan, nan, nan, nan, why)
@@ -193,7 +201,8 @@ class PoolRunner(SerialRunner):
         if self.workers < 1:
             raise InputError(f"workers must be at least 1, got {workers}")
         self.pool = ProcessPoolExecutor(self.workers,
-                                        mp_context=multiprocessing.get_context("spawn"))
+                                        mp_context=multiprocessing.get_context("spawn"),
+                                        initializer=quiet_worker)
 
     def __call__(self, trials: list[Trial]) -> list[TrialResult]:
         trials = list(trials)
