@@ -15,49 +15,114 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .morris_lecar import DIRECTED_NAMES
 
 FORMAT = "cpgbiped.optimize/1"
 SECONDARY_FORMAT = "cpgbiped.secondary/1"
+MAX_POINTS = 10_000  # Pareto points or secondary targets a file may hold
+MAX_BYTES = 50_000_000  # a result file larger than this is refused before it is parsed
+
+# JSON Schemas (draft 2020-12) of the two file kinds, checked (jsonschema) before anything is
+# used: types, lengths, required fields. JSON "number" excludes strings and booleans.
+_NUM = {"type": "number"}
+_POS = {"type": "number", "exclusiveMinimum": 0}
+_POINT = {
+    "type": "object", "required": ["weights"],
+    "properties": {
+        "weights": {"type": "array", "items": _NUM, "minItems": 3, "maxItems": 3},
+        "errors_deg": {"type": ["array", "null"], "items": _NUM, "minItems": 3, "maxItems": 3},
+        "robustness": {"type": ["number", "null"]},
+        "objectives": {"type": ["object", "null"], "additionalProperties": _NUM},
+        "i_app": _NUM, "phi": _POS,
+    },
+}
+RESULT_SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "type": "object", "required": ["format", "gait", "i_app", "phi", "chosen", "pareto"],
+    "properties": {
+        "format": {"const": FORMAT},
+        "gait": {"enum": ["walk", "run", "jump", "hop"]},
+        "i_app": _NUM, "phi": _POS, "chosen": _POINT, "paper": _POINT,
+        "pareto": {"type": "array", "items": _POINT, "minItems": 1, "maxItems": MAX_POINTS},
+    },
+}
+SECONDARY_SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "type": "object", "required": ["format", "targets"],
+    "properties": {
+        "format": {"const": SECONDARY_FORMAT},
+        "targets": {"type": "array", "minItems": 1, "maxItems": MAX_POINTS, "items": {
+            "type": "object",
+            "required": ["target", "source", "i_app", "phi", "directed_weights"],
+            "properties": {
+                "target": {"type": "string"},
+                "source": {"enum": ["walk", "run", "jump", "hop"]},
+                "i_app": _NUM, "phi": _POS, "found": {"type": "boolean"},
+                "directed_weights": {"type": "object", "required": list(DIRECTED_NAMES),
+                                     "properties": {n: _NUM for n in DIRECTED_NAMES},
+                                     "additionalProperties": False},
+            }}},
+    },
+}
 
 
-def load_result(path: str | Path) -> dict:
-    """A primary-gait result file, validated; clear errors for anything else."""
+def read_json_file(path: str | Path, schema: dict, what: str) -> dict:
+    """A JSON file checked against ``schema`` (jsonschema) before use: one clear InputError
+    for a missing, oversized, unreadable, too deeply nested or malformed file, naming the
+    first place where it breaks the schema. NaN and infinities are refused too."""
     import json
+
+    import jsonschema
 
     p = Path(path)
     try:
+        if p.stat().st_size > MAX_BYTES:
+            raise InputError(f"{what} {str(p)!r} is larger than {MAX_BYTES // 1_000_000} MB")
         data = json.loads(p.read_text())
     except FileNotFoundError:
-        raise InputError(f"result file {str(p)!r} does not exist") from None
+        raise InputError(f"{what} {str(p)!r} does not exist") from None
+    except IsADirectoryError:
+        raise InputError(f"{what} {str(p)!r} is a folder, not a file") from None
+    except RecursionError:
+        raise InputError(f"{what} {str(p)!r} is nested too deeply to be a result") from None
     except (OSError, ValueError) as e:
-        raise InputError(f"result file {str(p)!r} is not readable JSON: {e}") from None
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise InputError(f"{str(p)!r} is not a cpgbiped optimiser result (format {FORMAT})")
+        raise InputError(f"{what} {str(p)!r} is not readable JSON: {e}") from None
+    fmt = schema["properties"]["format"]["const"]
+    if not isinstance(data, dict) or data.get("format") != fmt:
+        raise InputError(f"{str(p)!r} is not a {what} (format {fmt})")
     try:
-        w = np.array(data["chosen"]["weights"], dtype=float)
-        pareto = [np.array(q["weights"], dtype=float) for q in data["pareto"]]
-    except (KeyError, TypeError, ValueError):
-        raise InputError(f"{str(p)!r} lacks chosen/pareto weights") from None
-    for v in [w] + pareto:
-        if v.shape != (3,) or not np.all(np.isfinite(v)):
-            raise InputError(f"{str(p)!r} holds weights that are not three finite numbers")
-    try:
-        cell = [float(data["i_app"]), float(data["phi"])]
-    except (KeyError, TypeError, ValueError):
-        raise InputError(f"{str(p)!r} lacks the network's i_app and phi") from None
-    if not all(np.isfinite(cell)):
-        raise InputError(f"{str(p)!r} holds an i_app or phi that is not finite")
-    # A physical search (``"kind": "physics"``) varies I_app and phi too: each point has its own.
-    for q in [data["chosen"]] + list(data["pareto"]):
-        for key in ("i_app", "phi"):
-            if key in q:
-                try:
-                    ok = np.isfinite(float(q[key]))
-                except (TypeError, ValueError):
-                    ok = False
-                if not ok:
-                    raise InputError(f"{str(p)!r} holds a point whose {key} is not finite")
+        jsonschema.validate(data, schema)
+    except jsonschema.ValidationError as e:
+        where = "/".join(str(x) for x in e.absolute_path) or "the top level"
+        raise InputError(f"{str(p)!r} is not a valid {what} at {where}: "
+                         f"{' '.join(e.message.split())[:160]}") from None
+    except RecursionError:
+        raise InputError(f"{what} {str(p)!r} is nested too deeply to be a result") from None
+    bad = _non_finite(data)
+    if bad:
+        raise InputError(f"{str(p)!r} holds a number that is not finite at {bad}")
     return data
+
+
+def _non_finite(x, where="") -> str | None:
+    if isinstance(x, float) and not np.isfinite(x):
+        return where or "the top level"
+    if isinstance(x, dict):
+        items = x.items()
+    elif isinstance(x, list):
+        items = enumerate(x)
+    else:
+        return None
+    for k, v in items:
+        r = _non_finite(v, f"{where}/{k}" if where else str(k))
+        if r:
+            return r
+    return None
+
+
+def load_result(path: str | Path) -> dict:
+    """A primary-gait (or physics) result file, checked against :data:`RESULT_SCHEMA`."""
+    return read_json_file(path, RESULT_SCHEMA, "cpgbiped optimiser result")
 
 
 def point_cell(data: dict, point: dict) -> tuple[float, float]:

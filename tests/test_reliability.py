@@ -440,3 +440,54 @@ def test_secondary_results_that_do_not_exist_are_refused(tmp_path):
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "is not a folder" in r.stderr
     assert not (tmp_path / "o").exists()
+
+
+def _result(**change):
+    from cpgbiped.cpg.results import FORMAT
+
+    point = {"weights": [0.39, -0.681, 0.489], "errors_deg": [0.0, 0.0, 0.0], "robustness": 1.0}
+    d = {"format": FORMAT, "gait": "walk", "i_app": 0.229, "phi": 0.254, "chosen": dict(point),
+         "pareto": [dict(point)], "paper": dict(point)}
+    for k, v in change.items():
+        if k.startswith("pareto0_"):
+            d["pareto"][0][k[8:]] = v
+        elif v is None:
+            d.pop(k)
+        else:
+            d[k] = v
+    return d
+
+
+@pytest.mark.parametrize("change,where", [
+    ({"pareto0_objectives": [1, 2]}, "pareto/0/objectives"),
+    ({"pareto0_errors_deg": [1.0, 2.0]}, "pareto/0/errors_deg"),
+    ({"gait": None}, "the top level"),
+    ({"pareto0_weights": ["0.1", "0.2", "0.3"]}, "pareto/0/weights/"),
+    ({"pareto0_weights": [True, 0.2, 0.3]}, "pareto/0/weights/0"),
+    ({"i_app": True}, "i_app"),
+    ({"pareto": []}, "pareto"),
+])
+def test_malformed_result_files_are_refused_before_any_rollout(tmp_path, change, where):
+    """check-pareto and validate --weights read one schema (jsonschema): wrong types and
+    lengths, missing fields, strings and booleans as numbers end in one line, exit 2, before
+    any rollout and without any output."""
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps(_result(**change)))
+    for args in (["check-pareto", str(path), "--out", str(tmp_path / "o")],
+                 ["validate", "--weights", str(path), "--seconds", "1"]):
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *args],
+                           capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2, r.stderr
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and f"at {where}" in lines[0], lines
+        assert time.perf_counter() - t0 < 20 and not (tmp_path / "o").exists()
+
+
+def test_deeply_nested_json_is_refused(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "check-pareto", str(path),
+                        "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "nested too deeply" in r.stderr or "not a cpgbiped optimiser result" in r.stderr

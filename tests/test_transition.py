@@ -174,11 +174,12 @@ def test_check_secondary_runs_each_weight_set_through_the_body(tmp_path):
 
 
 @pytest.mark.parametrize("change,says", [
-    ({"source": "gallop"}, "malformed"),
-    ({"i_app": "0.2"}, "numbers"),
-    ({"phi": True}, "numbers"),
-    ({"phi": -1.0}, "phi > 0"),
-    ({"directed_weights": {"w_LF->RF": 1.0}}, "12 directed"),
+    ({"source": "gallop"}, "at targets/0/source"),
+    ({"i_app": "0.2"}, "at targets/0/i_app"),
+    ({"phi": True}, "at targets/0/phi"),
+    ({"phi": -1.0}, "at targets/0/phi"),
+    ({"directed_weights": {"w_LF->RF": 1.0}}, "at targets/0/directed_weights"),
+    ({"i_app": float("nan")}, "not finite at targets/0/i_app"),
 ])
 def test_malformed_secondary_files_fail_before_any_rollout(tmp_path, change, says):
     r = _cli("check-secondary", str(_secondary_file(tmp_path, **change)), timeout=60)
@@ -191,4 +192,4 @@ def test_a_file_that_is_not_a_secondary_result_is_refused(tmp_path):
     p = tmp_path / "x.json"
     p.write_text(json.dumps({"format": "cpgbiped.result/1", "targets": []}))
     r = _cli("check-secondary", str(p), timeout=60)
-    assert r.returncode == 2 and "not a cpgbiped secondary results file" in r.stderr
+    assert r.returncode == 2 and "is not a cpgbiped secondary results file (format" in r.stderr

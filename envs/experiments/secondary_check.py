@@ -10,53 +10,29 @@ body. A target is confirmed physically when both name it and the body does not f
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.cpg.morris_lecar import DIRECTED_NAMES, PRIMARY_GAITS
-from cpgbiped.cpg.results import SECONDARY_FORMAT
+from cpgbiped.cpg.morris_lecar import DIRECTED_NAMES
 
 KEYS = ("physical_gait", "cpg_gait", "fell", "fell_at_s", "duty_factor", "lr_phase_lag",
         "flight", "double_support", "stride_period_s", "speed_mps", "footfalls_per_stride")
-MAX_TARGETS = 64
 
 
 def load_secondary(path) -> list[dict]:
     """The targets of a secondary results file, each checked before any rollout."""
+    from cpgbiped.cpg.results import SECONDARY_SCHEMA, read_json_file
+
     p = Path(path)
-    try:
-        data = json.loads(p.read_text())
-    except FileNotFoundError:
-        raise InputError(f"secondary results file {str(p)!r} does not exist") from None
-    except (OSError, ValueError, RecursionError) as e:
-        raise InputError(f"secondary results file {str(p)!r} is not readable JSON: "
-                         f"{type(e).__name__}") from None
-    if not isinstance(data, dict) or data.get("format") != SECONDARY_FORMAT:
-        raise InputError(f"{str(p)!r} is not a cpgbiped secondary results file (format "
-                         f"{SECONDARY_FORMAT})")
-    targets = data.get("targets")
-    if not isinstance(targets, list) or not 1 <= len(targets) <= MAX_TARGETS:
-        raise InputError(f"{str(p)!r}: 'targets' must be a list of 1-{MAX_TARGETS} entries")
+    data = read_json_file(p, SECONDARY_SCHEMA, "cpgbiped secondary results file")
+    targets = data["targets"]
     out = []
-    for k, t in enumerate(targets):
-        try:
-            name, source = t["target"], t["source"]
-            w = t["directed_weights"]
-            if not isinstance(name, str) or source not in PRIMARY_GAITS:
-                raise ValueError("target/source")
-            if not isinstance(w, dict) or set(w) != set(DIRECTED_NAMES):
-                raise ValueError("directed_weights must name the 12 directed weights")
-            vals = [w[n] for n in DIRECTED_NAMES] + [t["i_app"], t["phi"]]
-            if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in vals):
-                raise ValueError("weights, i_app and phi must be numbers")
-            if not np.all(np.isfinite(vals)) or t["phi"] <= 0:
-                raise ValueError("weights, i_app and phi must be finite, phi > 0")
-        except (KeyError, TypeError, ValueError) as e:
-            raise InputError(f"{str(p)!r}: target {k} is malformed ({e})") from None
-        out.append({"target": name, "source": source, "weights": vals[:12],
+    for t in targets:  # the schema has checked names, types and phi > 0; finite numbers too
+        w = t["directed_weights"]
+        out.append({"target": t["target"], "source": t["source"],
+                    "weights": [float(w[n]) for n in DIRECTED_NAMES],
                     "i_app": float(t["i_app"]), "phi": float(t["phi"]),
                     "found": bool(t.get("found", False))})
     return out
