@@ -17,6 +17,8 @@ right (LF<->RF, LE<->RE), "horizontal" swaps flexor and extensor (LF<->LE, RF<->
 """
 from __future__ import annotations
 
+import logging
+
 import pickle
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -189,16 +191,28 @@ def connect_dask(address: str | None, n_workers: int = 2):
         from distributed import Client, LocalCluster
     except ImportError:  # pragma: no cover - pinned dependency
         raise InputError("dask.distributed is not installed") from None
-    if address is not None and not str(address).startswith("tcp://"):
-        raise InputError(f"Dask scheduler address must look like tcp://host:port, got {address!r}")
+    if address is not None:
+        check_dask_address(address)
     try:
         if address is None:
             cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+                                   dashboard_address=None, silence_logs=logging.ERROR)
             return Client(cluster), cluster
-        return Client(address, timeout="10s"), None
-    except OSError as e:
-        raise InputError(f"cannot reach the Dask scheduler {address!r}: {e}") from None
+        return Client(address, timeout="3s"), None
+    except (OSError, TimeoutError) as e:
+        raise InputError(f"cannot reach the Dask scheduler {address!r}: "
+                         f"{' '.join(str(e).split())[:120]}") from None
+
+
+def check_dask_address(address: str) -> tuple[str, int]:
+    """(host, port) of a tcp://host:port address; one clear error for anything else."""
+    import re
+
+    m = re.fullmatch(r"tcp://([A-Za-z0-9.\-]+|\[[0-9A-Fa-f:]+\]):(\d{1,5})", str(address))
+    if not m or not 0 < int(m.group(2)) < 65536:
+        raise InputError(f"Dask scheduler address must look like tcp://host:port, got "
+                         f"{address!r}")
+    return m.group(1), int(m.group(2))
 
 
 class DaskEvaluator:

@@ -491,3 +491,34 @@ def test_deeply_nested_json_is_refused(tmp_path):
                         "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
     assert "nested too deeply" in r.stderr or "not a cpgbiped optimiser result" in r.stderr
+
+
+@pytest.mark.parametrize("address,says", [("tcp://", "tcp://host:port"),
+                                          ("tcp://host:99999", "tcp://host:port"),
+                                          ("tcp://127.0.0.1:9", "cannot reach")])
+def test_a_bad_dask_address_is_one_line_at_once(tmp_path, address, says):
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "optimize", "--gait", "walk",
+                        "--dask", address, "--out", str(tmp_path / "o")], capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], lines
+    assert time.perf_counter() - t0 < 15
+
+
+def test_an_on_screen_gl_backend_is_refused_in_one_line():
+    env = dict(os.environ, MUJOCO_GL="glfw")
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "validate", "--seconds", "1"],
+                       capture_output=True, text=True, timeout=60, env=env)
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [
+        r.stderr.strip().splitlines()[0]] and "MUJOCO_GL" in r.stderr
+
+
+def test_the_matsuoka_network_uses_its_one_preset_whatever_the_gait():
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "validate", "--network",
+                        "matsuoka", "--gait", "run", "--seconds", "2", "--json"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    assert s["preset"] == "walk" and s["gait"] == "run"

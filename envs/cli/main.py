@@ -93,6 +93,10 @@ def check_workers(a) -> None:
     n = getattr(a, "workers", None)
     dask = getattr(a, "dask", None)
     cores = os.cpu_count() or 1
+    if dask not in (None, "local"):
+        from cpgbiped.cpg.optimize import check_dask_address
+
+        check_dask_address(dask)
     if n is not None and n > cores and (dask is None or dask == "local"):
         raise _input_error(f"--workers {n} is more than this machine's {cores} cores (each "
                            f"worker is a process of about 200 MB); use at most {cores}, or "
@@ -497,7 +501,7 @@ def _network(a):
     from cpgbiped.cpg.network import build
 
     kind = a.network
-    preset = a.preset or a.gait
+    preset = a.preset or ("walk" if kind == "matsuoka" else a.gait)  # its only preset
     if a.weights is None:
         net = build(kind, preset, seed=a.seed)
         return net, f"{kind} {preset}" + (f", seed {a.seed}" if a.seed is not None else "")
@@ -1192,7 +1196,7 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-GL_BACKENDS = ("osmesa", "egl", "glfw")
+GL_BACKENDS = ("osmesa", "egl")  # off-screen only: glfw needs a display (and warns without)
 
 
 class Terminated(KeyboardInterrupt):
