@@ -12,7 +12,14 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_a_wheel_installs_one_top_level_name_with_its_data(tmp_path):
     """What ``pip install .`` installs: the wheel's top-level names, and the data files the code
     reads (gains, feedback choice, the MJCF body)."""
-    r = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps",
+    import shutil
+
+    # from a copy of the source tree: a build/ folder left by an earlier build would put its
+    # stale files into the wheel
+    src = tmp_path / "src"
+    shutil.copytree(ROOT, src, ignore=shutil.ignore_patterns(
+        ".git", "out", "build", "*.egg-info", "__pycache__", ".pytest_cache", "docs"))
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps",
                         "-q", "-w", str(tmp_path)],
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
@@ -20,9 +27,9 @@ def test_a_wheel_installs_one_top_level_name_with_its_data(tmp_path):
     names = zipfile.ZipFile(wheel).namelist()
     top = {n.split("/")[0] for n in names if ".dist-info/" not in n}
     assert top == {"cpgbiped"}
-    for f in ("cpgbiped/envs/gains.json", "cpgbiped/envs/gains_root.json",
+    for f in ("cpgbiped/envs/control/gains.json", "cpgbiped/envs/control/gains_root.json",
               "cpgbiped/cpg/feedback_gains.json", "cpgbiped/models/biped/biped.xml",
-              "cpgbiped/models/biped/scene.xml", "cpgbiped/envs/cli.py"):
+              "cpgbiped/models/biped/scene.xml", "cpgbiped/envs/cli/main.py"):
         assert f in names, f
     entry = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("entry_points.txt")))
     assert b"cpgbiped = cpgbiped.envs.cli.main:run" in entry
