@@ -43,7 +43,7 @@ RESULT_SCHEMA = {
         "format": {"const": FORMAT},
         "gait": {"enum": ["walk", "run", "jump", "hop"]},
         "i_app": _NUM, "phi": _POS, "chosen": _POINT, "paper": _POINT,
-        "pareto": {"type": "array", "items": _POINT, "minItems": 1, "maxItems": MAX_POINTS},
+        "pareto": {"type": "array", "items": _POINT, "maxItems": MAX_POINTS},
     },
 }
 SECONDARY_SCHEMA = {

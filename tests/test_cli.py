@@ -40,7 +40,7 @@ def test_help_reads_like_a_manual():
 
 @pytest.mark.parametrize("args,msg", [
     (["hopf", "--gait", "trot"], "unknown gait 'trot'"),
-    (["reproduce", "--dt", "-1"], "dt must be positive"),
+    (["reproduce", "--dt", "-1"], "must be an RK4 step in [0.001, 0.1]"),
     (["hopf", "--beta", "nan"], "must be finite"),
     (["frobnicate"], "invalid choice"),
 ])

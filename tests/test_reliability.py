@@ -465,7 +465,7 @@ def _result(**change):
     ({"pareto0_weights": ["0.1", "0.2", "0.3"]}, "pareto/0/weights/"),
     ({"pareto0_weights": [True, 0.2, 0.3]}, "pareto/0/weights/0"),
     ({"i_app": True}, "i_app"),
-    ({"pareto": []}, "pareto"),
+    ({"pareto": [{"weights": [0.1, 0.2]}]}, "pareto/0/weights"),
 ])
 def test_malformed_result_files_are_refused_before_any_rollout(tmp_path, change, where):
     """check-pareto and validate --weights read one schema (jsonschema): wrong types and
