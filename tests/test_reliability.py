@@ -522,3 +522,20 @@ def test_the_matsuoka_network_uses_its_one_preset_whatever_the_gait():
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
     assert s["preset"] == "walk" and s["gait"] == "run"
+
+
+@pytest.mark.parametrize("cmd", [["render", "--seconds", "1", "--out"],
+                                 ["optimize", "--gait", "hop", "--pop", "8", "--gens", "2", "--out"],
+                                 ["validate", "--seconds", "1", "--rrd"]])
+def test_an_output_name_too_long_for_the_file_system_fails_before_any_work(tmp_path, cmd):
+    """A name the file system refuses once the temporary names are added to it fails at once,
+    in one line, and leaves no lock, staging folder or partial file behind."""
+    suffix = {"render": ".mp4", "validate": ".rrd"}.get(cmd[0], "")
+    name = "n" * 240 + suffix
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *cmd, str(tmp_path / name)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "too long" in lines[0], lines
+    assert time.perf_counter() - t0 < 20 and list(tmp_path.iterdir()) == []

@@ -162,8 +162,30 @@ def out_file(path: str | None, option: str, suffix: str) -> str | None:
         raise _input_error(f"{option} must name a {suffix} file, got {path!r}")
     if os.path.isdir(path):
         raise _input_error(f"{option} names a folder, not a {suffix} file: {path!r}")
+    _check_name_length(path, option)
     _check_writable_ancestor(os.path.dirname(os.path.abspath(path)), path, option)
     return path
+
+
+NAME_ROOM = 40  # characters the temporary and staging names add to an output's name
+
+
+def _check_name_length(path: str, option: str) -> None:
+    """The output's name, and the temporary names written beside it (".<name>.staging-..."),
+    must fit the file system's limit: checked before any work, not at the final commit."""
+    name = os.path.basename(os.path.normpath(os.path.abspath(path)))
+    probe = os.path.dirname(os.path.abspath(path))
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    try:
+        limit = os.pathconf(probe, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    parts = [p for p in os.path.abspath(path).split(os.sep) if p]
+    if any(len(p.encode()) > limit for p in parts[:-1]) or len(name.encode()) + NAME_ROOM > limit:
+        raise _input_error(f"{option}: the name {name[:40]!r}... is too long for this file system "
+                           f"(at most {limit - NAME_ROOM} bytes, leaving room for the "
+                           f"temporary names beside it)")
 
 
 def _check_writable_ancestor(folder: str, path: str, option: str) -> None:
@@ -181,6 +203,7 @@ def out_dir(path: str, option: str = "--out") -> str:
     """An output folder the user named: not a file, under a writable folder."""
     if os.path.exists(path) and not os.path.isdir(path):
         raise _input_error(f"{option} names a file, not a folder: {path!r}")
+    _check_name_length(path, option)
     _check_writable_ancestor(os.path.abspath(path), path, option)
     return path
 
