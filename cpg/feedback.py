@@ -291,72 +291,55 @@ def _mt_rhs(y, dy, P, noise_row, inp):
         dy[ANKLE[c]] += rate * r * inp[c]
 
 
+@njit(cache=True, inline="always")
+def _rhs(code, y, dy, P, colsum, C, S, kn, row, inp):
+    """dy/dt of any network with its feedback terms (layouts of P per kind above)."""
+    if code == KIND_HOPF:
+        _hopf_fb_rhs(y, dy, P, C, S, kn)
+    elif code == KIND_MATSUOKA:
+        _mt_rhs(y, dy, P, row, inp)
+    else:  # the Morris-Lecar forms
+        _ml_rhs(y, dy, P, colsum, inp)
+
+
 @njit(cache=True)
 def advance(code, P, y, K, sensors, n_sub, h, noise, step0, inp, scratch):
-    """Advance state y by n_sub RK4 steps of h model units with the feedback of ``sensors``
-    held (``inp`` receives the feedback terms, see :func:`inputs`). ``step0``: index of the
-    first 1 ms step (Matsuoka noise row). ``scratch``: (6, 24) work space. Returns False when
-    the state left the network's range (the caller stops)."""
-    inputs(code, K, y, sensors, inp)
+    """Advance state y by n_sub RK4 steps of h model units with the feedback held: ``inp``,
+    the terms :func:`inputs` computed from ``sensors`` and the state at the start (the Hopf
+    form recomputes its term from the state in every stage). ``step0``: index of the first
+    1 ms step (Matsuoka noise row). ``scratch``: (6, 24) work space. Returns False when the
+    state left the network's range (the caller stops)."""
     D = y.shape[0]
     k1, k2, k3, k4, tmp = scratch[0, :D], scratch[1, :D], scratch[2, :D], scratch[3, :D], scratch[4, :D]
-    if code == KIND_ML or code == KIND_ML_ANTAGONIST or code == KIND_ML_ANGLE or \
-            code == KIND_ML_RESET:
-        colsum = np.zeros(4)
+    colsum = np.zeros(4)
+    C = S = np.empty((4, 4))
+    kn = np.zeros(2)
+    bound = 1e6
+    if code == KIND_HOPF:
+        C = P[7:23].reshape((4, 4))
+        S = P[23:39].reshape((4, 4))
+        for leg in range(2):
+            kn[leg] = K * sensors[leg]
+    elif code != KIND_MATSUOKA:  # Morris-Lecar: W's column sums
         for j in range(4):
             for i in range(4):
                 colsum[i] += P[2 + 4 * j + i]
-        for _ in range(n_sub):
-            _ml_rhs(y, k1, P, colsum, inp)
-            for q in range(D):
-                tmp[q] = y[q] + 0.5 * h * k1[q]
-            _ml_rhs(tmp, k2, P, colsum, inp)
-            for q in range(D):
-                tmp[q] = y[q] + 0.5 * h * k2[q]
-            _ml_rhs(tmp, k3, P, colsum, inp)
-            for q in range(D):
-                tmp[q] = y[q] + h * k3[q]
-            _ml_rhs(tmp, k4, P, colsum, inp)
-            for q in range(D):
-                y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
         bound = 1.5  # cpg.integrate.ML_RANGE
-    elif code == KIND_HOPF:
-        C = P[7:23].reshape((4, 4))
-        S = P[23:39].reshape((4, 4))
-        kn = np.empty(2)
-        for leg in range(2):
-            kn[leg] = K * sensors[leg]
-        for _ in range(n_sub):
-            _hopf_fb_rhs(y, k1, P, C, S, kn)
-            for q in range(D):
-                tmp[q] = y[q] + 0.5 * h * k1[q]
-            _hopf_fb_rhs(tmp, k2, P, C, S, kn)
-            for q in range(D):
-                tmp[q] = y[q] + 0.5 * h * k2[q]
-            _hopf_fb_rhs(tmp, k3, P, C, S, kn)
-            for q in range(D):
-                tmp[q] = y[q] + h * k3[q]
-            _hopf_fb_rhs(tmp, k4, P, C, S, kn)
-            for q in range(D):
-                y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
-        bound = 1e6
-    else:
-        empty = np.empty(0)
-        for s in range(n_sub):
-            row = noise[step0 + s] if noise.shape[0] > step0 + s else empty
-            _mt_rhs(y, k1, P, row, inp)
-            for q in range(D):
-                tmp[q] = y[q] + 0.5 * h * k1[q]
-            _mt_rhs(tmp, k2, P, row, inp)
-            for q in range(D):
-                tmp[q] = y[q] + 0.5 * h * k2[q]
-            _mt_rhs(tmp, k3, P, row, inp)
-            for q in range(D):
-                tmp[q] = y[q] + h * k3[q]
-            _mt_rhs(tmp, k4, P, row, inp)
-            for q in range(D):
-                y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
-        bound = 1e6
+    empty = np.empty(0)
+    for s in range(n_sub):
+        row = noise[step0 + s] if noise.shape[0] > step0 + s else empty
+        _rhs(code, y, k1, P, colsum, C, S, kn, row, inp)
+        for q in range(D):
+            tmp[q] = y[q] + 0.5 * h * k1[q]
+        _rhs(code, tmp, k2, P, colsum, C, S, kn, row, inp)
+        for q in range(D):
+            tmp[q] = y[q] + 0.5 * h * k2[q]
+        _rhs(code, tmp, k3, P, colsum, C, S, kn, row, inp)
+        for q in range(D):
+            tmp[q] = y[q] + h * k3[q]
+        _rhs(code, tmp, k4, P, colsum, C, S, kn, row, inp)
+        for q in range(D):
+            y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q])
     for q in range(D):
         if not (abs(y[q]) < bound):
             return False
@@ -388,6 +371,7 @@ def run_open(net: LoopNetwork, n_ticks: int, sensors: np.ndarray | None = None) 
         if sensors is not None:
             s[:len(sensors[k])] = sensors[k]
         blend_at(k * net.tick_s, net.P_ab, net.knots, net.P)
+        inputs(net.code, net.gain, y, s, inp)
         if not advance(net.code, net.P, y, net.gain, s, net.n_sub, net.h, net.noise,
                        k * net.n_sub, inp, scratch):
             out[k + 1:] = np.nan

@@ -115,6 +115,12 @@ FEEDBACK_HELP = ("feed the body's sensors back into the CPG, stepped with the ph
                  "--feedback K: gain K; without it the network runs open loop (K = 0)")
 
 
+def feedback_option(sp, note: str = "") -> None:
+    """``--feedback [K]`` on a subcommand (``note`` appended to its help)."""
+    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
+                    metavar="K", help=FEEDBACK_HELP + note)
+
+
 def feedback_gain(a, kind: str) -> float:
     """The gain of --feedback [K] for a network of ``kind`` (0 without the option)."""
     from cpgbiped.cpg.feedback import RECOMMENDED, check_gain
@@ -719,7 +725,7 @@ def cmd_phase_response(a) -> int:
 def cmd_transition(a) -> int:
     from cpgbiped.cpg import io
     from cpgbiped.envs.media.render import check_backend, check_video_size, gait_diagram, render_video
-    from cpgbiped.envs.experiments.transition import check_transition, transition
+    from cpgbiped.envs.experiments.transition import WINDOW_CYCLES, check_transition, transition
 
     seconds = a.seconds if a.seconds is not None else a.at + a.ramp + 12.0
     check_transition(a.network, getattr(a, "from"), a.to, a.at, a.ramp, seconds)
@@ -756,7 +762,7 @@ def cmd_transition(a) -> int:
               f"CPG {b['cpg_gait']}, {b['speed_mps']:.2f} m/s")
         print(f"  after  ({f['start_s']:.2f}-{f['end_s']:g} s): physical {f['physical_gait']}, "
               f"CPG {f['cpg_gait']}, {f['speed_mps']:.2f} m/s")
-        print(f"  sliding windows of {3} CPG cycles: "
+        print(f"  sliding windows of {WINDOW_CYCLES} CPG cycles: "
               + " ".join(w["physical_gait"] for w in res["windows"]))
         print(f"  fell: {'at %.2f s' % res['fell_at_s'] if res['fell'] else 'no'}; switched to "
               f"{dst}: " + (f"after {res['cycles_to_switch']} CPG cycles"
@@ -768,7 +774,7 @@ def cmd_transition(a) -> int:
 
 def cmd_sweep(a) -> int:
     from cpgbiped.cpg import io
-    from cpgbiped.envs.experiments.sweep import check_pair, picture, sweep
+    from cpgbiped.envs.experiments.sweep import check_pair, picture, schedule, sweep
 
     check_pair(a.pair)
     out_dir(a.out)
@@ -785,8 +791,8 @@ def cmd_sweep(a) -> int:
     if a.video:
         from cpgbiped.envs.media.render import render_video
 
-        sch_t = [4.0, 4.0 + a.ramp_seconds, 8.0 + a.ramp_seconds, 8.0 + 2 * a.ramp_seconds]
-        render_video(rec, stem + ".mp4", 30.0, 640, 480, float(rec.t[-1]), marks=sch_t)
+        render_video(rec, stem + ".mp4", 30.0, 640, 480, float(rec.t[-1]),
+                     marks=schedule(a.ramp_seconds).t)
         written.append(stem + ".mp4")
     if a.json:
         print(io.to_json(res))
@@ -877,8 +883,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="remove the CPG's ankle drive (the reflexes stay): the ablation")
         sp.add_argument("--rrd", required=rrd_required, metavar="FILE.rrd",
                         help="also write a rerun recording")
-        sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended",
-                        default=None, metavar="K", help=FEEDBACK_HELP)
+        feedback_option(sp)
 
     sp = add("validate", cmd_validate, "drive the biped with a network and measure the gait", """\
         A network (--network, --preset, --weights; default the Morris-Lecar preset of --gait)
@@ -907,8 +912,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=20.0,
                     help="simulated seconds after 2 s of settling (default 20)")
     sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
-    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
-                    metavar="K", help=FEEDBACK_HELP)
+    feedback_option(sp)
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("render", cmd_render, "render a rollout off-screen to mp4", """\
@@ -950,8 +954,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "replace the Morris-Lecar preset's")
         sp.add_argument("--seed", type=seed_arg, default=None,
                         help="random initial CPG state from this seed (default: the preset's)")
-        sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended",
-                        default=None, metavar="K", help=FEEDBACK_HELP)
+        feedback_option(sp)
 
     sp = add("robustness", cmd_robustness, "push envelope, friction and CPG-state survival",
              """\
@@ -999,8 +1002,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=None,
                     help="whole rollout, s (default: the change's end + 12 s)")
     sp.add_argument("--network", default="ml", choices=("ml", "hopf"))
-    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
-                    metavar="K", help=FEEDBACK_HELP + " (Morris-Lecar)")
+    feedback_option(sp, " (Morris-Lecar)")
     sp.add_argument("--width", type=count_arg(1), default=640)
     sp.add_argument("--height", type=count_arg(1), default=480)
     sp.add_argument("--fps", type=positive_arg, default=30.0)
@@ -1020,8 +1022,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--ramp-seconds", type=finite_arg, default=40.0, metavar="R",
                     help="length of each ramp, s in [5, 200] (default 40)")
     sp.add_argument("--network", default="ml", choices=("ml", "hopf"))
-    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
-                    metavar="K", help=FEEDBACK_HELP + " (Morris-Lecar)")
+    feedback_option(sp, " (Morris-Lecar)")
     sp.add_argument("--video", action="store_true", help="also render the sweep to mp4")
     sp.add_argument("--out", default="out/sweep", metavar="DIR")
     sp.add_argument("--json", action="store_true", help="print JSON")
@@ -1133,8 +1134,7 @@ def build_parser() -> argparse.ArgumentParser:
                          f"{MAX_ROBUSTNESS_STATES})")
     sp.add_argument("--lock-time-objective", action="store_true",
                     help="add the objective: model time until the phases stay within 2 deg")
-    sp.add_argument("--feedback", type=feedback_arg, nargs="?", const="recommended", default=None,
-                    metavar="K", help="--physics only: " + FEEDBACK_HELP)
+    feedback_option(sp, " (--physics only)")
     sp.add_argument("--out", default="out/optimize", help="output folder (default out/optimize)")
     sp.add_argument("--quiet", action="store_true", help="no progress bar")
 

@@ -400,8 +400,8 @@ def step_closed(advance_first, code, NP, P_ab, knots, y, K, n_sub, h, noise, ste
     Returns False when the network's state left its range."""
     if advance_first:
         fb_blend_at(t_s - tick_s, P_ab, knots, NP)
-        if not fb_advance(code, NP, y, K, sensors, n_sub, h, noise, step0, scratch[5, :4],
-                          scratch):
+        # ``fb``: the terms computed at the last tick from ``sensors`` and this same state
+        if not fb_advance(code, NP, y, K, sensors, n_sub, h, noise, step0, fb, scratch):
             return False
     body_sensors(qpos, sens, ix, weight_n, tick_s, sensors)
     fb_inputs(code, K, y, sensors, fb)

@@ -44,7 +44,7 @@ def onsets(t: np.ndarray, act: np.ndarray) -> np.ndarray:
     return t[up] + f * (t[up + 1] - t[up])
 
 
-def _psi(t, rec):
+def _psi(rec):
     """(touchdown times, their phase after the last left-extensor onset, in cycles)."""
     on = onsets(rec.t, rec.drive[:, 2])
     td, _ = edges(rec.t, debounce(rec.contact[:, 0], rec.dt))
@@ -67,7 +67,7 @@ def phase_response(network: Network, K: float, phases=PHASES, impulse: float = I
     total = t_last + WINDOW_CYCLES * T_cpg_s
     ref = rollout(network, total, poses=False, feedback=K, stop_on_fall=False)
     on_ref = onsets(ref.t, ref.drive[:, 2])
-    td_ref, psi_ref = _psi(ref.t, ref)
+    td_ref, psi_ref = _psi(ref)
     dphi, relock, fell = [], [], []
     for ph in phases:
         tp = sp.time_at(float(ph))
@@ -84,7 +84,7 @@ def phase_response(network: Network, K: float, phases=PHASES, impulse: float = I
             dphi.append(float("nan"))
         before = psi_ref[(td_ref < tp) & (td_ref >= tp - 3 * sp.period_s)]
         psi0 = float(np.nanmean(before)) if len(before) else float("nan")
-        td, psi = _psi(rec.t, rec)
+        td, psi = _psi(rec)
         after = td > tp
         relock.append(_relock(td[after], psi[after], psi0, tp, T_cpg_s)
                       if rec.fell_at is None else None)

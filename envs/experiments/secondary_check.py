@@ -73,11 +73,8 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2) -> dict:
     else:
         rows = [_one(j) for j in jobs]
     out = {}
-    for t, r in zip(targets, rows):
-        key = t["target"] if t["target"] not in out else f"{t['target']} from {t['source']}"
-        if key in out or any(k.startswith(t["target"]) for k in out):
-            key = f"{t['target']} from {t['source']}"
-        out[key] = r
+    for t, r in zip(targets, rows):  # a target found twice: the second named by its source
+        out[t["target"] if t["target"] not in out else f"{t['target']} from {t['source']}"] = r
     return out
 
 

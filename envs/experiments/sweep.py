@@ -19,7 +19,7 @@ from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import build
 
 from cpgbiped.envs.simulation.rollout import rollout
-from cpgbiped.envs.experiments.transition import _window
+from cpgbiped.envs.experiments.transition import window_summary
 
 PAIRS = {"walk-run": ("walk", "run"), "jump-hop": ("jump", "hop")}
 START_S, HOLD_S, TAIL_S = 4.0, 4.0, 4.0
@@ -61,7 +61,7 @@ def sweep(pair: str, ramp_s: float = 40.0, kind: str = "ml", feedback: float = 0
     windows = []
     t0 = START_S - WINDOW_S
     while t0 + WINDOW_S <= rec.t[-1] + 1e-9:
-        w = _window(net, rec, t0, t0 + WINDOW_S, rec.fell_at)
+        w = window_summary(net, rec, t0, t0 + WINDOW_S, rec.fell_at)
         tt = np.linspace(t0, t0 + WINDOW_S, 31)
         w["drive"] = float(sch.at(tt).mean())
         w["leg"] = "up" if t0 + WINDOW_S / 2 <= t_top else "down"

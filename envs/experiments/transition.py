@@ -53,7 +53,7 @@ def check_transition(kind: str, a: str, b: str, at_s: float, ramp_s: float, seco
     return seconds
 
 
-def _window(net, rec, t0, t1, fell_at):
+def window_summary(net, rec, t0, t1, fell_at):
     """Summary of [t0, t1] with the fall counted only when it lies inside."""
     inside = fell_at is not None and fell_at <= (np.inf if t1 is None else t1)  # fell by its end
     r = replace(rec, fell_at=fell_at if inside else None)
@@ -71,12 +71,12 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
                   stop_on_fall=False, feedback=feedback)
     fell_at = rec.fell_at
     T = to.period_s()
-    before = _window(net, rec, SETTLE_S, at_s, fell_at)
+    before = window_summary(net, rec, SETTLE_S, at_s, fell_at)
     slides = []
     k = 0
     while at_s + (k + WINDOW_CYCLES) * T <= rec.t[-1] + 1e-9:
         t0 = at_s + k * T
-        slides.append(_window(to, rec, t0, t0 + WINDOW_CYCLES * T, fell_at))
+        slides.append(window_summary(to, rec, t0, t0 + WINDOW_CYCLES * T, fell_at))
         k += 1
     settled = None
     names = [w["physical_gait"] for w in slides]
@@ -85,7 +85,7 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
             settled = i
             break
     start = at_s + (settled if settled is not None else len(slides)) * T
-    after = _window(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
+    after = window_summary(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
     res = {"network": kind, "from": a, "to": b, "at_s": float(at_s), "ramp_s": float(ramp_s),
            "seconds": seconds, "feedback_gain": rec.feedback_gain, "cpg_period_to_s": T,
            "before": before, "after": after, "fell": fell_at is not None,

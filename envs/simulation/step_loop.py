@@ -38,6 +38,20 @@ def _library():
 _mj_step = _library()
 
 
+@njit(inline="always")
+def _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, xfrc, torso_id):
+    """Tick k's physics steps, with the push's force during them when k is the push's tick;
+    returns MjData.time advanced by ``dt_s`` per step."""
+    if k == push_tick:
+        xfrc[torso_id, 0] = push_force
+    for _ in range(control_every):
+        _mj_step(m_addr, d_addr)
+        t_s += dt_s
+    if k == push_tick:
+        xfrc[torso_id, 0] = 0.0
+    return t_s
+
+
 @njit
 def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, sa, sdt, P, S, qpos,
               qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec, fall_height, fall_pitch,
@@ -54,13 +68,8 @@ def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, 
             return k + 1, status
         if k == n_ticks:
             return k + 1, status if k > 0 else 0
-        if k == push_tick:
-            xfrc[torso_id, 0] = push_force
-        for _ in range(control_every):
-            _mj_step(m_addr, d_addr)
-            t_s += dt_s
-        if k == push_tick:
-            xfrc[torso_id, 0] = 0.0
+        t_s = _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, xfrc,
+                     torso_id)
         if k > 0 and status == 1:  # row k - 1 fell; tick k's steps are done
             return k + 1, status
     return k_end, 0
@@ -68,26 +77,22 @@ def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, 
 
 @njit
 def run_ticks_closed(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, code, NP,
-                     P_ab, knots, y, K, n_sub, h, noise, act_c, act_w, weight_n, tick_s, sensors, fb, scratch, P,
-                     S, qpos,
-                     qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec, fall_height,
-                     fall_pitch, push_tick, push_force, xfrc, torso_id):
-    """:func:`run_ticks` with the CPG stepped in the loop (:func:`cpgbiped.envs.control.control_kernel.tick_closed`)."""
+                     P_ab, knots, y, K, n_sub, h, noise, act_c, act_w, weight_n, tick_s, sensors,
+                     fb, scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a,
+                     rec, fall_height, fall_pitch, push_tick, push_force, xfrc, torso_id):
+    """:func:`run_ticks` with the CPG stepped in the loop
+    (:func:`cpgbiped.envs.control.control_kernel.tick_closed`)."""
     for k in range(k0, k_end):
-        status = kernel.tick_closed(k, t_s, code, NP, P_ab, knots, y, K, n_sub, h, noise, act_c, act_w,
-                                    weight_n, tick_s, sensors, fb, scratch, P, S, qpos, qvel, sens, xpos,
-                                    act, ctrl, afrc, avel, ix, v, a, rec, fall_height, fall_pitch)
+        status = kernel.tick_closed(k, t_s, code, NP, P_ab, knots, y, K, n_sub, h, noise, act_c,
+                                    act_w, weight_n, tick_s, sensors, fb, scratch, P, S, qpos,
+                                    qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
+                                    fall_height, fall_pitch)
         if k > 0 and status == 2:
             return k + 1, status
         if k == n_ticks:
             return k + 1, status if k > 0 else 0
-        if k == push_tick:
-            xfrc[torso_id, 0] = push_force
-        for _ in range(control_every):
-            _mj_step(m_addr, d_addr)
-            t_s += dt_s
-        if k == push_tick:
-            xfrc[torso_id, 0] = 0.0
+        t_s = _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, xfrc,
+                     torso_id)
         if k > 0 and status == 1:
             return k + 1, status
     return k_end, 0
