@@ -539,3 +539,36 @@ def test_an_output_name_too_long_for_the_file_system_fails_before_any_work(tmp_p
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "too long" in lines[0], lines
     assert time.perf_counter() - t0 < 20 and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("where,value,says", [
+    (("shared", "e_on"), "0.5", "at shared/e_on"),
+    (("shared", "e_on"), True, "at shared/e_on"),
+    (("corners", "synchronous", "k_ax"), None, "at corners/synchronous"),
+    (("corners", "synchronous", "bogus"), 1.0, "at corners/synchronous"),
+    (("shared", "e_on"), float("nan"), "not finite at shared/e_on"),
+])
+def test_a_malformed_gains_file_is_refused_before_any_rollout(tmp_path, where, value, says):
+    """tune --start reads a gains file through one schema (jsonschema): a gain given as a
+    string or a boolean, a missing or unknown gain, or a non-finite number is one line, exit 2,
+    before any rollout and with no output."""
+    from cpgbiped.envs.control.controller import GAINS_FILE
+
+    d = json.loads(GAINS_FILE.read_text())
+    node = d
+    for k in where[:-1]:
+        node = node[k]
+    if value is None:
+        node.pop(where[-1])
+    else:
+        node[where[-1]] = value
+    path = tmp_path / "gains.json"
+    path.write_text(json.dumps(d))
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "tune", "--gait", "walk",
+                        "--start", str(path), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], lines
+    assert time.perf_counter() - t0 < 20 and not (tmp_path / "o").exists()

@@ -186,18 +186,37 @@ def params_from_dict(d: dict, what: str = "gains") -> ControlParams:
                             for c in kernel.CORNERS})
 
 
-def read_gains(path: str | Path = GAINS_FILE) -> tuple[ControlParams, list]:
-    """(parameters, provenance) of a gains file (:data:`GAINS_FORMAT`)."""
-    import json
+def gains_schema() -> dict:
+    """The JSON Schema (draft 2020-12) of a gains file, built from the kernel's parameter names:
+    every shared gain and every corner's every gain, each a JSON number (not a string nor a
+    boolean), no unknown names; ``provenance`` a list of objects."""
+    num = {"type": "number"}
 
-    try:
-        d = json.loads(Path(path).read_text())
-    except (OSError, ValueError) as e:
-        raise InputError(f"cannot read the gains file {str(path)!r}: {e}") from None
-    if not isinstance(d, dict) or d.get("format") != GAINS_FORMAT:
-        raise InputError(f"{str(path)!r} is not a gains file (format {GAINS_FORMAT})")
-    prov = d.get("provenance", [])
-    return params_from_dict(d, str(path)), prov if isinstance(prov, list) else []
+    def block(names):
+        return {"type": "object", "required": list(names), "additionalProperties": False,
+                "properties": {n: num for n in names}}
+
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "type": "object", "required": ["format", "shared", "corners"],
+        "properties": {
+            "format": {"const": GAINS_FORMAT},
+            "shared": block(kernel.SHARED),
+            "corners": {"type": "object", "required": list(kernel.CORNERS),
+                        "additionalProperties": False,
+                        "properties": {c: block(kernel.BLENDED) for c in kernel.CORNERS}},
+            "provenance": {"type": "array", "items": {"type": "object"}, "maxItems": 10_000},
+        },
+    }
+
+
+def read_gains(path: str | Path = GAINS_FILE) -> tuple[ControlParams, list]:
+    """(parameters, provenance) of a gains file (:data:`GAINS_FORMAT`), checked against
+    :func:`gains_schema` (and for finite numbers) before it is used."""
+    from cpgbiped.cpg.results import read_json_file
+
+    d = read_json_file(path, gains_schema(), "gains file")
+    return params_from_dict(d, str(path)), d.get("provenance", [])
 
 
 # The one parameter set, for every gait and every network.
