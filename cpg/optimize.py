@@ -18,6 +18,7 @@ right (LF<->RF, LE<->RE), "horizontal" swaps flexor and extensor (LF<->LE, RF<->
 from __future__ import annotations
 
 import logging
+import os
 
 import pickle
 from dataclasses import asdict, dataclass
@@ -193,10 +194,17 @@ def connect_dask(address: str | None, n_workers: int = 2):
         raise InputError("dask.distributed is not installed") from None
     if address is not None:
         check_dask_address(address)
+    # Dask's start-up and shutdown logs (some 30 INFO lines) stay quiet unless asked for with
+    # CPGBIPED_DASK_LOGS=1. Its loggers do not propagate to the root logger, which absl
+    # (dm_control) configures with a handler of its own, so that ERROR alone reaches stderr.
+    level = logging.INFO if os.environ.get("CPGBIPED_DASK_LOGS") else logging.ERROR
+    for name in ("distributed", "dask"):
+        logging.getLogger(name).propagate = False
+        logging.getLogger(name).setLevel(level)
     try:
         if address is None:
             cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
+                                   dashboard_address=None, silence_logs=level)
             return Client(cluster), cluster
         return Client(address, timeout="3s"), None
     except (OSError, TimeoutError) as e:

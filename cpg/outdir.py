@@ -7,11 +7,15 @@
    it gets a one-line error instead of silently replacing the first run's results;
 2. the run writes its files into a staging folder beside the target (same file system);
 3. ``commit()`` hard-links the target's other files (those the run does not replace) into the
-   staging folder and then exchanges the two folders in one step (Linux ``renameat2`` with
+   staging folder (copies them where the system refuses a link: another user's file, another
+   file system) and then exchanges the two folders in one step (Linux ``renameat2`` with
    ``RENAME_EXCHANGE``); where the file system cannot exchange, it renames the target aside
    and the staging folder in, and a later run restores the target if it was interrupted in
    between. Either way the target holds the complete old set or the complete new set;
-4. on an error or Ctrl-C before the commit, the staging folder is removed and the target is
+4. what the commit must carry over is checked when the folder is taken, before any work: a
+   target that is a mount point or holds one, or a file that can be neither linked nor read,
+   is refused in one line then rather than at the commit;
+5. on an error or Ctrl-C before the commit, the staging folder is removed and the target is
    untouched; a target that did not exist is not created.
 Files the run must keep across an interrupt (checkpoints) live beside the target
 (:meth:`ResultDir.state`, ``.<name>.<file>``), never in the staging folder, so that an
@@ -24,6 +28,7 @@ import errno
 import fcntl
 import os
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 
@@ -52,6 +57,60 @@ def _exchange(a: Path, b: Path) -> bool:
 
 def _aside(target: Path) -> Path:
     return target.parent / f".{target.name}.previous"
+
+
+_CANNOT_LINK = (errno.EPERM, errno.EACCES, errno.EXDEV, errno.EMLINK)
+
+
+def _carry(src, dst) -> None:
+    """Carry one of the target's files into the staging folder: a hard link, or a copy where
+    the system refuses the link (``protected_hardlinks`` on another user's file, a file on
+    another file system, too many links)."""
+    try:
+        os.link(src, dst, follow_symlinks=False)
+    except OSError as e:
+        if e.errno not in _CANNOT_LINK:
+            raise
+        shutil.copy2(src, dst, follow_symlinks=False)
+
+
+def check_replaceable(target: Path, probe_dir: Path) -> None:
+    """Refuse, before any work, a target folder that the commit could not carry over: a mount
+    point (it cannot be renamed), a folder that holds one (the commit would move or delete
+    another file system's files), or an entry that can be neither hard-linked into
+    ``probe_dir`` (same file system) nor read and copied."""
+    if not target.exists():
+        return
+    if os.path.ismount(target):
+        raise InputError(f"output folder {str(target)!r} is a mount point and cannot be "
+                         f"replaced; choose a folder inside it")
+    probe = probe_dir / ".link-probe"
+
+    def refuse(path, why):
+        raise InputError(f"output folder {str(target)!r} holds {str(path)!r}, which {why}; "
+                         f"move it or choose another --out")
+
+    def walk_error(e):
+        refuse(e.filename, f"cannot be read ({e.strerror})")
+
+    for root, dirs, files in os.walk(target, onerror=walk_error):
+        for d in dirs:
+            full = os.path.join(root, d)
+            if os.path.ismount(full):
+                refuse(full, "is a mount point")
+        for f in files:
+            full = os.path.join(root, f)
+            try:
+                os.link(full, probe, follow_symlinks=False)
+                os.unlink(probe)
+                continue
+            except OSError as e:
+                if e.errno not in _CANNOT_LINK:
+                    refuse(full, f"cannot be carried into the new set ({e.strerror})")
+            if os.path.islink(full):
+                continue  # copy2(follow_symlinks=False) recreates the link itself
+            if not stat.S_ISREG(os.lstat(full).st_mode) or not os.access(full, os.R_OK):
+                refuse(full, "can be neither linked nor copied into the new result set")
 
 
 def recover(target: Path) -> None:
@@ -108,6 +167,11 @@ class ResultDir:
         for old in parent.glob(f".{self.target.name}.staging-*"):
             shutil.rmtree(old, ignore_errors=True)
         self.staging = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.staging-", dir=parent))
+        try:
+            check_replaceable(self.target, self.staging)
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
         return self
 
     def path(self, name: str) -> Path:
@@ -124,10 +188,10 @@ class ResultDir:
                 dst = self.staging / f.name
                 if dst.exists() or f.name.startswith(".") and f.name.endswith(".tmp"):
                     continue
-                if f.is_dir():
-                    shutil.copytree(f, dst, copy_function=os.link)
+                if f.is_dir() and not f.is_symlink():
+                    shutil.copytree(f, dst, symlinks=True, copy_function=_carry)
                 else:
-                    os.link(f, dst)
+                    _carry(f, dst)
             mode = os.stat(self.target).st_mode & 0o777
             os.chmod(self.staging, mode)
             if _exchange(self.staging, self.target):

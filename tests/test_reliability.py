@@ -1,5 +1,6 @@
 """Reliability: results all-or-nothing under Ctrl-C, one run per output folder, videos in
 bounded memory, and one line (never a traceback) for every bad input."""
+import errno
 import hashlib
 import json
 import os
@@ -572,3 +573,91 @@ def test_a_malformed_gains_file_is_refused_before_any_rollout(tmp_path, where, v
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and says in lines[0], lines
     assert time.perf_counter() - t0 < 20 and not (tmp_path / "o").exists()
+
+
+def _mount_tmpfs(where) -> bool:
+    where.mkdir(parents=True, exist_ok=True)
+    try:
+        return subprocess.run(["mount", "-t", "tmpfs", "none", str(where)],
+                              capture_output=True, timeout=30).returncode == 0
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+
+
+@pytest.mark.parametrize("inside", [True, False])
+def test_a_target_the_commit_could_not_replace_is_refused_before_any_work(tmp_path, inside):
+    """A target folder that is a mount point (it cannot be renamed) or holds one (the commit
+    would carry another file system's files, and later delete them) fails in one line when
+    the folder is taken, before the search runs, and is left as it was."""
+    d = tmp_path / "res"
+    mnt = d / "data" if inside else d
+    if not _mount_tmpfs(mnt):
+        pytest.skip("mounting a tmpfs needs root")
+    try:
+        (mnt / "keep.txt").write_text("another file system's file\n")
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--out", str(d)],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2, r.stderr
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and "mount point" in lines[0], lines
+        assert time.perf_counter() - t0 < 20
+        assert (mnt / "keep.txt").read_text() == "another file system's file\n"
+        assert sorted(p.name for p in d.iterdir()) == (["data"] if inside else ["keep.txt"])
+        assert not list(tmp_path.glob(".res.staging-*"))
+    finally:
+        subprocess.run(["umount", str(mnt)], capture_output=True, timeout=30)
+
+
+def test_a_file_the_system_will_not_link_is_copied_or_refused_up_front(tmp_path, monkeypatch):
+    """protected_hardlinks refuses a link to another user's file (EPERM). Such a file of the
+    target's is copied into the new set when it can be read, and refused, before any work,
+    when it cannot (here os.access says so, as it would for a user without read access)."""
+    d = tmp_path / "res"
+    d.mkdir()
+    (d / "theirs.txt").write_text("a file of another user\n")
+    real_link, real_access = os.link, os.access
+
+    def no_link(src, dst, **kw):
+        if os.path.basename(src) == "theirs.txt":
+            raise PermissionError(errno.EPERM, "Operation not permitted", src)
+        return real_link(src, dst, **kw)
+
+    monkeypatch.setattr(os, "link", no_link)
+    assert main(OPT + ["--out", str(d)]) == 0
+    assert (d / "theirs.txt").read_text() == "a file of another user\n" and (d / "hop.json").exists()
+    before = snapshot(d)
+    monkeypatch.setattr(os, "access", lambda p, m, **kw: False if str(p).endswith("theirs.txt")
+                        and m == os.R_OK else real_access(p, m, **kw))
+    t0 = time.perf_counter()
+    assert main(OPT + ["--seed", "5", "--out", str(d)]) == 2
+    assert time.perf_counter() - t0 < 10  # refused when the folder was taken, not after the search
+    assert snapshot(d) == before and not list(tmp_path.glob(".res.staging-*"))
+
+
+def test_a_locked_folder_is_refused_before_the_dask_cluster_starts(tmp_path):
+    """optimize --physics --dask into a folder another run holds: one line at once, and no
+    LocalCluster started (it would print its start-up logs and take seconds)."""
+    d = tmp_path / "phys"
+    with outdir.ResultDir(d):
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *PHYS[:-3], "--dask",
+                            "--quiet", "--out", str(d)], capture_output=True, text=True,
+                           timeout=120)
+        took = time.perf_counter() - t0
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [r.stderr.strip().splitlines()[0]]
+    assert "another cpgbiped run is writing" in r.stderr and "distributed" not in r.stderr
+    assert took < 15, took
+
+
+def test_a_dask_run_keeps_dask_s_logs_quiet(tmp_path):
+    """A successful optimize --physics --dask (a LocalCluster) prints its result and nothing on
+    stderr: Dask's ~30 INFO lines of start-up and shutdown stay quiet unless asked for."""
+    d = tmp_path / "o"
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "optimize", "--physics",
+                        "--gait", "hop", "--pop", "4", "--gens", "1", "--seconds", "2",
+                        "--trials", "0", "--dask", "--quiet", "--out", str(d)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == "" and (d / "hop_physics.json").exists()

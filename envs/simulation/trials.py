@@ -229,26 +229,36 @@ class PoolRunner(SerialRunner):
 
 class DaskRunner(SerialRunner):
     """Trials on a Dask cluster: a ``LocalCluster`` of ``workers`` processes when ``address``
-    is None, else the scheduler at ``tcp://host:port``."""
+    is None, else the scheduler at ``tcp://host:port``. The cluster is started (or the
+    scheduler reached) at the first batch of trials, not when the runner is made, so that a
+    run refused by its output folder's lock starts no process."""
 
     def __init__(self, seconds: float, settle_s: float = SETTLE_S, stop_on_fall: bool = True,
                  address: str | None = None, workers: int = 2):
         super().__init__(seconds, settle_s, stop_on_fall)
+        self.address, self.n_workers = address, workers
+        self.client = self.cluster = None
+
+    def _connect(self) -> None:
         from cpgbiped.cpg.optimize import connect_dask
 
-        self.client, self.cluster = connect_dask(address, workers)
+        self.client, self.cluster = connect_dask(self.address, self.n_workers)
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
 
     def __call__(self, trials: list[Trial]) -> list[TrialResult]:
+        if self.client is None:
+            self._connect()
         trials = list(trials)
         jobs = [(trials[s], *self.args) for s in chunks(len(trials), self.workers)]
         futures = self.client.map(_run_chunk, jobs, pure=False)
         return [r for part in self.client.gather(futures) for r in part]
 
     def close(self):
-        self.client.close()
+        if self.client is not None:
+            self.client.close()
         if self.cluster is not None:
             self.cluster.close()
+        self.client = self.cluster = None
 
 
 def mean_finite(x) -> float:
