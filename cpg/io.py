@@ -1,13 +1,20 @@
 """Atomic output files: write to a temporary name in the same folder, then rename.
 
 A crash or Ctrl-C mid-write leaves the previous file (or none), never a half-written one.
+Inside :func:`all_or_nothing`, the renames of every file written in the block wait for its
+end and happen together, with SIGINT and SIGTERM held back for those few system calls: the
+files that belong together (render's video, pictures and recording) land as one set or not
+at all.
 """
 from __future__ import annotations
 
 import json
 import os
+import signal
 import tempfile
+import threading
 from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Iterator
 
@@ -28,24 +35,74 @@ def ensure_dir(path: str | os.PathLike) -> Path:
     return p
 
 
+_PENDING: ContextVar[list | None] = ContextVar("cpgbiped_pending_renames", default=None)
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; rename it onto ``path`` when the block succeeds."""
+    """Yield a temporary path beside ``path``; rename it onto ``path`` when the block succeeds
+    (inside :func:`all_or_nothing`: when that block succeeds)."""
     final = Path(path)
     ensure_dir(final.parent if str(final.parent) else ".")
     fd, tmp = tempfile.mkstemp(prefix=f".{final.name}.", suffix=suffix or final.suffix,
                                dir=final.parent)
     os.close(fd)
     tmp = Path(tmp)
+    pending = _PENDING.get()
     try:
         yield tmp
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; outputs get the usual mode
+        if pending is not None:
+            pending.append((tmp, final))
+            return
         os.replace(tmp, final)
     finally:
-        if tmp.exists():
+        if tmp.exists() and not (pending and pending[-1][0] == tmp):
             tmp.unlink()
+
+
+def staged(path: str | os.PathLike) -> Path:
+    """Where the file that will land on ``path`` is now: its temporary name inside an
+    :func:`all_or_nothing` block that has written it, else ``path`` itself."""
+    final = Path(path)
+    for tmp, dst in reversed(_PENDING.get() or []):
+        if dst == final:
+            return tmp
+    return final
+
+
+@contextmanager
+def all_or_nothing() -> Iterator[None]:
+    """Every file written with :func:`atomic_path` in this block lands at its end, together;
+    on an error or interrupt none does and the temporary files go."""
+    # SIGINT and SIGTERM are held back while the renames run (recorded, then raised again):
+    # a Python-level deferral, since a blocked signal mask would not stop the kernel from
+    # handing the signal to another thread (BLAS, ffmpeg readers) and Python then running the
+    # handler between two renames.
+    pending: list = []
+    held: list[int] = []
+    old: dict = {}
+    token = _PENDING.set(pending)
+    try:
+        try:
+            yield
+        finally:
+            _PENDING.reset(token)
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                old[sig] = signal.signal(sig, lambda signum, frame: held.append(signum))
+        for tmp, final in pending:
+            os.replace(tmp, final)
+    finally:
+        for sig, handler in old.items():
+            if handler is not None:
+                signal.signal(sig, handler)
+        for tmp, _ in pending:
+            tmp.unlink(missing_ok=True)  # renamed ones are gone; the rest never land
+    for sig in held[:1]:
+        signal.raise_signal(sig)
 
 
 def _default(o):

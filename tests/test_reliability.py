@@ -661,3 +661,55 @@ def test_a_dask_run_keeps_dask_s_logs_quiet(tmp_path):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert r.stderr == "" and (d / "hop_physics.json").exists()
+
+
+RENDER = ["render", "--seconds", "1", "--width", "160", "--height", "120"]
+
+
+def _render_set(folder) -> dict:
+    """Each file of a render (video, four pictures, recording) in ``folder`` -> (inode,
+    digest); the recording's digest is left out (it holds a time stamp), its inode says which
+    run wrote it."""
+    return {f: (os.stat(folder / f).st_ino, None if f.endswith(".rrd") else
+                hashlib.sha256((folder / f).read_bytes()).hexdigest())
+            for f in sorted(os.listdir(folder)) if f.startswith("r")}
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_render_s_video_pictures_and_recording_land_together(tmp_path, sig):
+    """A render interrupted at moments spread over its run leaves its folder holding the
+    complete earlier set (seed 1, the same files) or a complete new one (seed 2: every file
+    replaced, the video and pictures those of seed 2), never a video without its pictures or
+    recording, and no temporary file."""
+    d = tmp_path / "v"
+    d.mkdir()
+    args = lambda seed: [sys.executable, "-m", "cpgbiped.envs.cli", *RENDER, "--seed",  # noqa
+                         str(seed), "--out", str(d / "r.mp4"), "--rrd", str(d / "r.rrd")]
+    t0 = time.perf_counter()
+    r = subprocess.run(args(2), capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stderr == "", r.stderr  # no library warning either
+    total = time.perf_counter() - t0
+    new = {f: h for f, (_, h) in _render_set(d).items()}
+    assert subprocess.run(args(1), capture_output=True, timeout=300).returncode == 0
+    old = _render_set(d)
+    assert len(old) == 6 and set(old) == set(new) and all(old[f][1] != new[f] for f in
+                                                          ("r.mp4", "r_chrono.png"))
+    landed = 0
+    for frac in (0.5, 0.75, 0.9, 0.97, 1.02):
+        p = subprocess.Popen(args(2), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        time.sleep(frac * total)
+        p.send_signal(sig)
+        p.wait(timeout=60)
+        err = p.stderr.read().decode().strip().splitlines()
+        if p.returncode != 0:
+            assert p.returncode == 128 + sig and len(err) == 1, (p.returncode, err)
+            landed += 1
+        state = _render_set(d)
+        assert sorted(os.listdir(d)) == sorted(old), os.listdir(d)  # no temporary file
+        is_old = state == old
+        is_new = all(state[f][0] != old[f][0] and state[f][1] == new[f] for f in old)
+        assert is_old or is_new, (frac, state)
+        if is_new:
+            assert subprocess.run(args(1), capture_output=True, timeout=300).returncode == 0
+            old = _render_set(d)
+    assert landed >= 3

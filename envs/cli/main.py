@@ -603,20 +603,22 @@ def cmd_render(a) -> int:
     out_file(a.rrd, "--rrd", ".rrd")
     check_backend()
     v, label = _validation(a, stop_on_fall=False, settle_s=0.0)
-    path = render_video(v.recording, a.out, a.fps, a.width, a.height, a.seconds,
-                        signals=not a.no_signals, fancy=a.fancy)
-    stem = os.path.splitext(a.out)[0]
-    gait_diagram(v.recording, stem + "_gait.png", v.metrics, label)
-    gait_cycle_picture(v.recording, v.metrics, stem + "_cycle.png", label)
-    signals_picture(v.recording, stem + "_signals.png", label)
+    from cpgbiped.cpg import io
     from cpgbiped.envs.media.chrono import chronophotograph, chrono_title
 
-    chronophotograph(v.recording, stem + "_chrono.png", v.metrics, chrono_title(label, v),
-                     period_s=v.summary()["cpg_period_s"])
-    if a.rrd:
-        from cpgbiped.envs.media.record import write_rrd
+    stem = os.path.splitext(a.out)[0]
+    with io.all_or_nothing():  # the video, its pictures and the recording land together
+        path = render_video(v.recording, a.out, a.fps, a.width, a.height, a.seconds,
+                            signals=not a.no_signals, fancy=a.fancy)
+        gait_diagram(v.recording, stem + "_gait.png", v.metrics, label)
+        gait_cycle_picture(v.recording, v.metrics, stem + "_cycle.png", label)
+        signals_picture(v.recording, stem + "_signals.png", label)
+        chronophotograph(v.recording, stem + "_chrono.png", v.metrics, chrono_title(label, v),
+                         period_s=v.summary()["cpg_period_s"])
+        if a.rrd:
+            from cpgbiped.envs.media.record import write_rrd
 
-        write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)}, {a.gait: path})
+            write_rrd(a.rrd, {a.gait: (v.recording, v.metrics)}, {a.gait: io.staged(path)})
     print(f"wrote {path}, {stem}_chrono.png, {stem}_gait.png, {stem}_cycle.png, "
           f"{stem}_signals.png"
           + (f", {a.rrd}" if a.rrd else ""))

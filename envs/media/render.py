@@ -315,7 +315,11 @@ def gait_cycle_picture(rec, metrics, path: str | Path, title: str = "",
         ax.set_title(n, fontsize=9)
         ax.set_xlabel("gait cycle (%)")
         ax.set_xlim(0, 100)
-    axes[0].legend(fontsize=7, frameon=False)
+    if axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(fontsize=7, frameon=False)
+    else:  # fewer than three touchdowns of either foot: no cycle to average
+        axes[0].text(0.5, 0.5, "fewer than 3 touchdowns\nper foot: no cycle", ha="center",
+                     va="center", transform=axes[0].transAxes, fontsize=8)
     fig.suptitle(title, fontsize=10, x=0.01, ha="left")
     fig.tight_layout()
     with atomic_path(path, suffix=".png") as tmp:
