@@ -684,8 +684,9 @@ def cmd_robustness(a) -> int:
     res = robustness(net, a.gait, gains)
     res["source"] = label
     stem = os.path.join(a.out, f"robustness_{net.kind}_{net.preset}")
-    io.write_json(stem + ".json", res)
-    envelope_picture(res, stem + ".png")
+    with io.all_or_nothing():  # the table and its picture land together
+        io.write_json(stem + ".json", res)
+        envelope_picture(res, stem + ".png")
     if a.json:
         print(io.to_json(res))
     else:
@@ -707,8 +708,9 @@ def cmd_phase_response(a) -> int:
     net.period()
     res = [phase_response(net, K, impulse=a.impulse) for K in _gains_to_compare(a, net.kind)]
     stem = os.path.join(a.out, f"phase_response_{net.kind}_{net.preset}")
-    io.write_json(stem + ".json", {"source": label, "by_gain": res})
-    picture(res, f"{label}: {a.impulse:g} N s push forwards", stem + ".png")
+    with io.all_or_nothing():
+        io.write_json(stem + ".json", {"source": label, "by_gain": res})
+        picture(res, f"{label}: {a.impulse:g} N s push forwards", stem + ".png")
     if a.json:
         print(io.to_json({"source": label, "by_gain": res}))
     else:
@@ -744,17 +746,18 @@ def cmd_transition(a) -> int:
              + (f", feedback K = {K:g}" if K else ""))
     marks = [(a.at, "change")] + ([(a.at + a.ramp, "end of ramp")] if a.ramp else [])
     written = []
-    if a.out:
-        path = render_video(rec, a.out, a.fps, a.width, a.height, seconds,
-                            marks=[m[0] for m in marks])
-        stem = os.path.splitext(a.out)[0]
-        gait_diagram(rec, stem + "_gait.png", None, label, window_s=None, marks=marks)
-        written += [str(path), stem + "_gait.png"]
-    if a.rrd:
-        from cpgbiped.envs.media.record import write_rrd
+    with io.all_or_nothing():  # the video, its gait diagram and the recording land together
+        if a.out:
+            path = render_video(rec, a.out, a.fps, a.width, a.height, seconds,
+                                marks=[m[0] for m in marks])
+            stem = os.path.splitext(a.out)[0]
+            gait_diagram(rec, stem + "_gait.png", None, label, window_s=None, marks=marks)
+            written += [str(path), stem + "_gait.png"]
+        if a.rrd:
+            from cpgbiped.envs.media.record import write_rrd
 
-        write_rrd(a.rrd, {f"{src}_to_{dst}": (rec, res)}, marks={f"{src}_to_{dst}": marks})
-        written.append(a.rrd)
+            write_rrd(a.rrd, {f"{src}_to_{dst}": (rec, res)}, marks={f"{src}_to_{dst}": marks})
+            written.append(a.rrd)
     if a.json:
         print(io.to_json(res))
     else:
@@ -787,15 +790,16 @@ def cmd_sweep(a) -> int:
         check_backend()
     res, rec = sweep(a.pair, a.ramp_seconds, a.network, K, poses=a.video)
     stem = os.path.join(a.out, f"sweep_{a.network}_{a.pair}" + (f"_K{K:g}" if K else ""))
-    io.write_json(stem + ".json", res)
-    picture(res, stem + ".png")
     written = [stem + ".json", stem + ".png"]
-    if a.video:
-        from cpgbiped.envs.media.render import render_video
+    with io.all_or_nothing():  # the JSON, the picture and the video land together
+        io.write_json(stem + ".json", res)
+        picture(res, stem + ".png")
+        if a.video:
+            from cpgbiped.envs.media.render import render_video
 
-        render_video(rec, stem + ".mp4", 30.0, 640, 480, float(rec.t[-1]),
-                     marks=schedule(a.ramp_seconds).t)
-        written.append(stem + ".mp4")
+            render_video(rec, stem + ".mp4", 30.0, 640, 480, float(rec.t[-1]),
+                         marks=schedule(a.ramp_seconds).t)
+            written.append(stem + ".mp4")
     if a.json:
         print(io.to_json(res))
     else:
