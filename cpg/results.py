@@ -20,6 +20,7 @@ from .morris_lecar import DIRECTED_NAMES
 FORMAT = "cpgbiped.optimize/1"
 SECONDARY_FORMAT = "cpgbiped.secondary/1"
 MAX_POINTS = 10_000  # Pareto points or secondary targets a file may hold
+MAX_OBJECTIVES = 32  # named objectives a point may carry
 MAX_BYTES = 50_000_000  # a result file larger than this is refused before it is parsed
 
 # JSON Schemas (draft 2020-12) of the two file kinds, checked (jsonschema) before anything is
@@ -32,7 +33,8 @@ _POINT = {
         "weights": {"type": "array", "items": _NUM, "minItems": 3, "maxItems": 3},
         "errors_deg": {"type": ["array", "null"], "items": _NUM, "minItems": 3, "maxItems": 3},
         "robustness": {"type": ["number", "null"]},
-        "objectives": {"type": ["object", "null"], "additionalProperties": _NUM},
+        "objectives": {"type": ["object", "null"], "additionalProperties": _NUM,
+                       "maxProperties": MAX_OBJECTIVES, "propertyNames": {"maxLength": 64}},
         "i_app": _NUM, "phi": _POS,
     },
 }
@@ -55,7 +57,7 @@ SECONDARY_SCHEMA = {
             "type": "object",
             "required": ["target", "source", "i_app", "phi", "directed_weights"],
             "properties": {
-                "target": {"type": "string"},
+                "target": {"type": "string", "maxLength": 64},
                 "source": {"enum": ["walk", "run", "jump", "hop"]},
                 "i_app": _NUM, "phi": _POS, "found": {"type": "boolean"},
                 "directed_weights": {"type": "object", "required": list(DIRECTED_NAMES),
@@ -91,7 +93,12 @@ def read_json_file(path: str | Path, schema: dict, what: str) -> dict:
     if not isinstance(data, dict) or data.get("format") != fmt:
         raise InputError(f"{str(p)!r} is not a {what} (format {fmt})")
     try:
-        jsonschema.validate(data, schema)
+        # the first error, not jsonschema.validate's best match among all of them: a large
+        # malformed file is refused at its first fault instead of after a full walk
+        validator = jsonschema.Draft202012Validator(schema)
+        e = next(validator.iter_errors(data), None)
+        if e is not None:
+            raise e
     except jsonschema.ValidationError as e:
         where = "/".join(str(x) for x in e.absolute_path) or "the top level"
         raise InputError(f"{str(p)!r} is not a valid {what} at {where}: "

@@ -690,12 +690,14 @@ def test_render_s_video_pictures_and_recording_land_together(tmp_path, sig):
     assert r.returncode == 0 and r.stderr == "", r.stderr  # no library warning either
     total = time.perf_counter() - t0
     new = {f: h for f, (_, h) in _render_set(d).items()}
+    t0 = time.perf_counter()
     assert subprocess.run(args(1), capture_output=True, timeout=300).returncode == 0
+    total = min(total, time.perf_counter() - t0)  # the shorter: most moments land in a run
     old = _render_set(d)
     assert len(old) == 6 and set(old) == set(new) and all(old[f][1] != new[f] for f in
                                                           ("r.mp4", "r_chrono.png"))
     landed = 0
-    for frac in (0.5, 0.75, 0.9, 0.97, 1.02):
+    for frac in (0.3, 0.5, 0.7, 0.85, 0.95, 1.02):
         p = subprocess.Popen(args(2), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         time.sleep(frac * total)
         p.send_signal(sig)
@@ -713,3 +715,113 @@ def test_render_s_video_pictures_and_recording_land_together(tmp_path, sig):
             assert subprocess.run(args(1), capture_output=True, timeout=300).returncode == 0
             old = _render_set(d)
     assert landed >= 3
+
+
+# -- peak memory at the largest accepted inputs (issue 24) -------------------------------------
+PEAK_LIMIT_GB = 4.0
+
+
+def _peak_rss_gb(args, cwd) -> tuple[int, float, str]:
+    """(exit status, peak resident memory in GB summed over the process and every descendant,
+    stderr) of one command, sampled every 50 ms."""
+    import psutil
+
+    p = subprocess.Popen([sys.executable, "-m", "cpgbiped.envs.cli", *args], cwd=cwd,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    root, top = psutil.Process(p.pid), 0
+    while p.poll() is None:
+        total = 0
+        try:
+            procs = [root] + root.children(recursive=True)
+        except psutil.Error:
+            procs = []
+        for q in procs:
+            try:
+                total += q.memory_info().rss
+            except psutil.Error:
+                pass
+        top = max(top, total)
+        time.sleep(0.05)
+    return p.returncode, top / 1e9, p.stderr.read()
+
+
+def _largest_inputs(tmp_path) -> dict:
+    """One command per bounded size-like input, each at its largest accepted value (read from
+    the code's own bounds) on an otherwise tiny problem."""
+    from cpgbiped.envs.cli.main import MAX_ROBUSTNESS_STATES
+    from cpgbiped.cpg.results import FORMAT, MAX_BYTES, MAX_OBJECTIVES, MAX_POINTS
+    from cpgbiped.envs.media.render import MAX_FPS, offscreen_size
+    from cpgbiped.envs.search.controller_tuning import MAX_CONDITIONS
+    from cpgbiped.envs.search.physics_search import MAX_TRIALS
+    from cpgbiped.envs.simulation.rollout import MAX_SECONDS
+
+    cores = str(os.cpu_count() or 1)
+    w, h = offscreen_size()
+    # the largest result file the schema accepts: the most points, each with the most named
+    # objectives under the longest names, every number at full precision
+    point = {"weights": [0.3900000000000001, -0.6810000000000001, 0.4890000000000001],
+             "errors_deg": [1e-300, 1e-300, 1e-300], "robustness": 0.12345678901234567,
+             "objectives": {f"{k:02d}".ljust(64, "o"): 0.12345678901234567
+                            for k in range(MAX_OBJECTIVES)}}
+    big = {"format": FORMAT, "gait": "walk", "i_app": 0.229, "phi": 0.254, "chosen": point,
+           "paper": point, "pareto": [point] * MAX_POINTS}
+    (tmp_path / "big.json").write_text(json.dumps(big))
+    assert (tmp_path / "big.json").stat().st_size <= MAX_BYTES
+    s = f"{MAX_SECONDS:g}"
+    return {
+        "longest rollout, recorded": ["validate", "--seconds", s, "--rrd", "v.rrd"],
+        "longest rollout, every preset": ["matrix", "--seconds", s, "--workers", cores],
+        "largest video frame and rate": ["render", "--seconds", "1", "--fps", f"{MAX_FPS:g}",
+                                         "--width", str(w), "--height", str(h), "--out", "r.mp4",
+                                         "--rrd", "r.rrd"],
+        "smallest RK4 step": ["reproduce", "--dt", "0.001"],
+        "most robustness states": ["optimize", "--gait", "hop", "--pop", "4", "--gens", "1",
+                                   "--robustness-objective", str(MAX_ROBUSTNESS_STATES),
+                                   "--quiet", "--out", "o1"],
+        "most physics trials, workers": ["optimize", "--physics", "--gait", "hop", "--pop", "4",
+                                         "--gens", "1", "--seconds", "2", "--trials",
+                                         str(MAX_TRIALS), "--workers", cores, "--quiet",
+                                         "--out", "o2"],
+        "most tuning conditions": ["tune", "--gait", "walk,run,jump,hop", "--pop", "4", "--gens",
+                                   "1", "--seconds", "4", "--conditions", str(MAX_CONDITIONS),
+                                   "--workers", cores, "--quiet", "--out", "o3"],
+        "largest result file": ["check-pareto", "big.json", "--first", "1", "--seconds", "1",
+                                "--quiet", "--out", "o5"],
+        "longest transition": ["transition", "--from", "walk", "--to", "run", "--at", "300",
+                               "--seconds", s],
+    }
+
+
+def test_peak_memory_stays_under_4_gb_at_the_largest_accepted_inputs(tmp_path):
+    """Every command driven at the largest value its bounds accept (longest rollout, largest
+    video, smallest step, most states, trials, conditions, points, workers, largest file)
+    completes, and the memory of its whole process tree stays under 4 GB at every moment."""
+    peaks = {}
+    for name, args in _largest_inputs(tmp_path).items():
+        code, gb, err = _peak_rss_gb(args, tmp_path)
+        assert code == 0, (name, err[-300:])
+        peaks[name] = round(gb, 2)
+    assert max(peaks.values()) < PEAK_LIMIT_GB, peaks
+
+
+def test_a_result_file_beyond_its_bounds_is_refused_at_once(tmp_path):
+    """More points or objectives than a result may hold, or an objective name too long: one
+    line, exit 2, within seconds (the first fault, not a walk over the whole file)."""
+    from cpgbiped.cpg.results import MAX_OBJECTIVES, MAX_POINTS
+
+    for change, where in (({"pareto": [_result()["chosen"]] * (MAX_POINTS + 1)}, "at pareto"),
+                          ({"pareto0_objectives": {f"o{k}": 1.0 for k in
+                                                   range(MAX_OBJECTIVES + 1)}},
+                           "at pareto/0/objectives"),
+                          ({"pareto0_objectives": {"o" * 65: 1.0}}, "at pareto/0/objectives")):
+        path = tmp_path / "r.json"
+        path.write_text(json.dumps(_result(**change)))
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "check-pareto", str(path),
+                            "--out", str(tmp_path / "o")], capture_output=True, text=True,
+                           timeout=60)
+        assert r.returncode == 2
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and where in lines[0], lines
+        assert time.perf_counter() - t0 < 15 and not (tmp_path / "o").exists()

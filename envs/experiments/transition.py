@@ -27,7 +27,7 @@ from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import PRESETS, build
 
 from cpgbiped.envs.gaits.criteria import SETTLE_S
-from cpgbiped.envs.simulation.rollout import check_seconds, rollout
+from cpgbiped.envs.simulation.rollout import check_seconds, rollout, window
 from cpgbiped.envs.gaits.validate import measure_recording
 
 WINDOW_CYCLES = 3  # CPG cycles of the target per sliding window
@@ -53,10 +53,17 @@ def check_transition(kind: str, a: str, b: str, at_s: float, ramp_s: float, seco
     return seconds
 
 
+CONTEXT_S = 2.0  # s of the recording before a window kept for the contacts' debouncing
+
+
 def window_summary(net, rec, t0, t1, fell_at):
-    """Summary of [t0, t1] with the fall counted only when it lies inside."""
+    """Summary of [t0, t1] with the fall counted only when it lies inside. Measured on the
+    recording cut to [t0 - CONTEXT_S, t1], so that each window costs its own length, not the
+    length of the rollout before it."""
     inside = fell_at is not None and fell_at <= (np.inf if t1 is None else t1)  # fell by its end
-    r = replace(rec, fell_at=fell_at if inside else None)
+    to_end = t1 is None or t1 >= rec.t[-1]  # an unstable rollout counts as fallen at its end
+    r = replace(window(rec, t0 - CONTEXT_S, t1), fell_at=fell_at if inside else None,
+                unstable=rec.unstable if to_end else None)
     s = measure_recording(net, None, r, t0, t_end=t1).summary()
     return {k: s.get(k) for k in KEYS} | {"start_s": float(t0),
                                           "end_s": float(rec.t[-1] if t1 is None else t1)}

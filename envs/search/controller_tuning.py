@@ -137,7 +137,12 @@ class TuneSettings:
             raise InputError(f"unknown algorithm {self.algorithm!r}: use {', '.join(ALGORITHMS)}")
         if not (np.isfinite(self.seconds) and 2.0 <= self.seconds <= 60.0):
             raise InputError(f"seconds per rollout must be in [2, 60], got {self.seconds}")
-        tuning_conditions(self.n_conditions)
+        for k, cond in enumerate(tuning_conditions(self.n_conditions)):
+            if "push" in cond and cond["push"][0] >= SETTLE_S + self.seconds:
+                raise InputError(
+                    f"tuning condition {k + 1} pushes at {cond['push'][0]:g} s, after the end of "
+                    f"a {SETTLE_S + self.seconds:g} s rollout: use --seconds above "
+                    f"{cond['push'][0] - SETTLE_S:g} or --conditions {k} or fewer")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
 

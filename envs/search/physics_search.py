@@ -61,6 +61,9 @@ FRICTION_RANGE = (0.7, 1.3)
 PUSH_NS = (2.0, 6.0)  # N s: 0.1-0.3 m/s to the 21 kg body
 
 
+MAX_TRIALS = 32  # perturbation trials per point (each one more rollout per point)
+
+
 @dataclass(frozen=True)
 class PhysicsSettings:
     """What one evaluation rolls out: ``seconds`` measured after ``settle_s``, plus
@@ -80,8 +83,8 @@ class PhysicsSettings:
                              f"got {self.froude:g}")
         if not (np.isfinite(self.seconds) and 1.0 <= self.seconds <= 120.0):
             raise InputError(f"seconds per rollout must be in [1, 120], got {self.seconds}")
-        if int(self.n_trials) < 0 or int(self.n_trials) > 32:
-            raise InputError(f"perturbation trials must be 0-32, got {self.n_trials}")
+        if int(self.n_trials) < 0 or int(self.n_trials) > MAX_TRIALS:
+            raise InputError(f"perturbation trials must be 0-{MAX_TRIALS}, got {self.n_trials}")
 
 
 def check_gait(gait: str) -> str:

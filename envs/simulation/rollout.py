@@ -5,7 +5,7 @@ its initial state when the body starts (t = 0); the body starts standing still.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import mujoco
@@ -24,7 +24,9 @@ from cpgbiped.envs.control.controller import CONTROL, ControlParams, CPGControll
 FALL_HEIGHT = 0.55  # torso (hip) height below which the biped has fallen (m); standing 0.86
 FALL_PITCH = 1.0  # |torso pitch| above which it has fallen (rad)
 # Any body other than a foot touching the floor (a knee, a shank, the torso) is a fall too.
-MAX_SECONDS = 600.0  # longest rollout (simulated s): bounds memory and time
+MAX_SECONDS = 600.0  # longest measured window (simulated s): bounds memory and time
+# A rollout is the measured window plus the settling before it (criteria.SETTLE_S, 2 s).
+MAX_ROLLOUT_S = MAX_SECONDS + 2.0
 CONTROL_EVERY = 2  # physics steps per control tick (2 ms each: a 4 ms control period)
 
 
@@ -57,10 +59,20 @@ class Recording:
     feedback_gain: float = 0.0  # K of cpg.feedback (0: open loop)
 
 
-def check_seconds(seconds: float, name: str = "seconds") -> float:
+def window(rec: Recording, t0: float, t1: float | None = None) -> Recording:
+    """The part of ``rec`` with t0 <= t <= t1 (t1 None: to the end): every per-tick array cut
+    alike, the rest (sample interval, fall time, model) kept."""
+    n = len(rec.t)
+    sel = (rec.t >= t0) & (rec.t <= (np.inf if t1 is None else t1))
+    cut = {f.name: getattr(rec, f.name)[sel] for f in fields(rec)
+           if isinstance(getattr(rec, f.name), np.ndarray) and len(getattr(rec, f.name)) == n}
+    return replace(rec, **cut)
+
+
+def check_seconds(seconds: float, name: str = "seconds", limit: float = MAX_SECONDS) -> float:
     if not (isinstance(seconds, (int, float, np.floating)) and np.isfinite(seconds)
-            and 0 < seconds <= MAX_SECONDS):
-        raise InputError(f"{name} must be a number in (0, {MAX_SECONDS:g}] s, got {seconds}")
+            and 0 < seconds <= limit):
+        raise InputError(f"{name} must be a number in (0, {limit:g}] s, got {seconds}")
     return float(seconds)
 
 
@@ -97,7 +109,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     into the CPG (:mod:`cpg.feedback`); 0 (default) integrates the network ahead, open loop,
     as the paper does; K > 0 steps it tick by tick with the sensors.
     """
-    seconds = check_seconds(seconds)
+    seconds = check_seconds(seconds, limit=MAX_ROLLOUT_S)
     push = check_push(push, seconds)
     K = 0.0 if feedback == 0 else check_gain(network.kind, feedback)  # any Network open loop
     if (to is None) != (change is None):
