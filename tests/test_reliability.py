@@ -410,11 +410,15 @@ def test_staging_folders_of_a_killed_run_are_cleaned_by_the_next(tmp_path):
 
 
 @pytest.mark.parametrize("cmd", [["optimize", "--physics", "--gait", "hop"], ["matrix"],
-                                 ["tune", "--gait", "walk"]])
+                                 ["tune", "--gait", "walk"], ["check-pareto", "RESULT"],
+                                 ["check-secondary", "RESULT"]])
 def test_workers_are_bounded_by_the_cores(tmp_path, cmd):
     n = (os.cpu_count() or 1) + 1
+    (tmp_path / "r.json").write_text("{}")  # never read: the bound is checked first
+    cmd = [str(tmp_path / "r.json") if c == "RESULT" else c for c in cmd]
     r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *cmd, "--workers", str(n)]
-                       + (["--out", str(tmp_path / "o")] if cmd[0] != "matrix" else []),
+                       + (["--out", str(tmp_path / "o")] if cmd[0] in ("optimize", "tune",
+                                                                        "check-pareto") else []),
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
@@ -825,3 +829,25 @@ def test_a_result_file_beyond_its_bounds_is_refused_at_once(tmp_path):
         lines = r.stderr.strip().splitlines()
         assert len(lines) == 1 and where in lines[0], lines
         assert time.perf_counter() - t0 < 15 and not (tmp_path / "o").exists()
+
+
+def test_an_interrupt_that_a_library_turns_into_its_own_error_is_still_one_line(monkeypatch,
+                                                                                capsys):
+    """A Ctrl-C that reaches a library which catches it and raises an error of its own (seen
+    as matplotlib's "Invalid bounding box" in a terminal's Ctrl-C) ends as an interrupt: one
+    line, exit 130, not an internal error."""
+    from cpgbiped.envs.cli import main as cli
+
+    def interrupted_in_a_library(a):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            raise ValueError("Invalid bounding box") from None
+
+    monkeypatch.setattr(cli, "cmd_matsuoka", interrupted_in_a_library)
+    assert cli.main(["matsuoka"]) == 130
+    assert capsys.readouterr().err.strip().splitlines() == ["cpgbiped: interrupted"]
+    monkeypatch.setattr(cli, "cmd_matsuoka", lambda a: 1 / 0)  # no signal: an internal error
+    assert cli.main(["matsuoka"]) == 1
+    assert "internal error: ZeroDivisionError" in capsys.readouterr().err

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import os
 import shlex
+import signal
 import sys
 import textwrap
 import time
@@ -822,8 +823,8 @@ def cmd_check_secondary(a) -> int:
     from cpgbiped.cpg import io
     from cpgbiped.envs.experiments.secondary_check import check_secondary, load_secondary, table
 
-    n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
     check_workers(a)
+    n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
     res = check_secondary(a.secondary, a.seconds, a.workers)
     if a.json:
         print(io.to_json(res))
@@ -1233,8 +1234,17 @@ class Terminated(KeyboardInterrupt):
     (staging folders removed, worker pools and Dask clusters shut down)."""
 
 
+_SIGNALLED: list[int] = []  # signals received during this run of main()
+
+
 def _on_sigterm(signum, frame):
+    _SIGNALLED.append(signum)
     raise Terminated()
+
+
+def _on_sigint(signum, frame):
+    _SIGNALLED.append(signum)
+    raise KeyboardInterrupt()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -1244,14 +1254,18 @@ def main(argv: list[str] | None = None) -> int:
     import signal
     import threading
 
-    previous = None
+    previous = {}
+    _SIGNALLED.clear()
     if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _on_sigterm)}
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, _on_sigint)
     try:
         return _main(argv)
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            if handler is not None:
+                signal.signal(sig, handler)
 
 
 def _main(argv: list[str] | None) -> int:
@@ -1279,6 +1293,13 @@ def _main(argv: list[str] | None) -> int:
         print("cpgbiped: interrupted", file=sys.stderr)
         return 130
     except Exception as e:  # noqa: BLE001 - the last resort: one line, never a bare traceback
+        if _SIGNALLED and not debug:
+            # the interrupt reached a library that turned it into an error of its own (seen
+            # once in some 55 terminal Ctrl-Cs: matplotlib's "Invalid bounding box"): it is
+            # still an interrupt, and the clean-up paths have run on the way out
+            term = _SIGNALLED[0] == signal.SIGTERM
+            print(f"cpgbiped: {'terminated' if term else 'interrupted'}", file=sys.stderr)
+            return 143 if term else 130
         if debug:
             import traceback
 
