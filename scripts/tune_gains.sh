@@ -1,20 +1,20 @@
 #!/usr/bin/env bash
-# Regenerate the one controller's gains (envs/gains.json) from the hand-set root
-# (envs/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
+# Regenerate the one controller's gains (envs/control/gains.json) from the hand-set root
+# (envs/control/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
 # order, each started from the one before. Every run is deterministic (its seed, its tuning
 # conditions), so the chain ends with the committed parameters, bit for bit; the last line
 # checks it. About 110 minutes on 2 cores. Usage:
 #     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
-# then `cp OUT/final/gains.json envs/gains.json` makes the result the controller's gains.
+# then `cp OUT/final/gains.json envs/control/gains.json` makes the result the controller's gains.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-out/tune_chain}
 mkdir -p "$OUT"
-prev=envs/gains_root.json
+prev=envs/control/gains_root.json
 stage() {  # stage NAME ARGS...: one tune run started from the previous stage's gains
   local name=$1; shift
   echo "tune_gains: $name: cpgbiped tune $* --start $prev"
-  cpgbiped tune "$@" --pop 24 --start "$prev" --out "$OUT/$name" --quiet
+  cpgbiped tune --pop 24 "$@" --start "$prev" --out "$OUT/$name" --quiet
   prev="$OUT/$name/gains.json"
 }
 stage w1 --gait walk --conditions 2 --gens 300 --seed 1   # bootstrap: the walk corner
@@ -35,9 +35,9 @@ import sys
 from cpgbiped.envs.control.controller import read_gains
 from cpgbiped.envs.search.controller_tuning import params_sha256
 new, _ = read_gains(sys.argv[1])
-old, _ = read_gains("envs/gains.json")
+old, _ = read_gains("envs/control/gains.json")
 same = params_sha256(new) == params_sha256(old)
 print("tune_gains: the chain ends with", "the committed gains (identical)" if same
-      else "gains that differ from envs/gains.json")
+      else "gains that differ from envs/control/gains.json")
 sys.exit(0 if same else 1)
 EOF

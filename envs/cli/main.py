@@ -1183,7 +1183,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
-                    help="gains file to start from (default: the controller's, envs/gains.json)")
+                    help="gains file to start from (default: the controller's, envs/control/gains.json)")
     sp.add_argument("--workers", type=count_arg(1), default=None,
                     help="rollout processes (default: one per core)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",
