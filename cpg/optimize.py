@@ -223,6 +223,19 @@ def check_dask_address(address: str) -> tuple[str, int]:
     return m.group(1), int(m.group(2))
 
 
+def reach_dask_scheduler(address: str, timeout_s: float = 3.0) -> None:
+    """Check a tcp://host:port address and that something listens there (one TCP connect of at
+    most ``timeout_s``), before any work or output: one clear error otherwise."""
+    import socket
+
+    host, port = check_dask_address(address)
+    try:
+        socket.create_connection((host.strip("[]"), port), timeout=timeout_s).close()
+    except OSError as e:
+        raise InputError(f"cannot reach the Dask scheduler {address!r}: "
+                         f"{e.strerror or type(e).__name__}") from None
+
+
 class DaskEvaluator:
     """Evaluate population chunks on a Dask cluster (a LocalCluster when no address)."""
 

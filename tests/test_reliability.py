@@ -498,18 +498,23 @@ def test_deeply_nested_json_is_refused(tmp_path):
     assert "nested too deeply" in r.stderr or "not a cpgbiped optimiser result" in r.stderr
 
 
+@pytest.mark.parametrize("cmd", [["optimize", "--gait", "walk"],
+                                 ["optimize", "--physics", "--gait", "hop"],
+                                 ["tune", "--gait", "walk"], ["secondary"]])
 @pytest.mark.parametrize("address,says", [("tcp://", "tcp://host:port"),
                                           ("tcp://host:99999", "tcp://host:port"),
                                           ("tcp://127.0.0.1:9", "cannot reach")])
-def test_a_bad_dask_address_is_one_line_at_once(tmp_path, address, says):
+def test_a_bad_dask_address_is_one_line_at_once(tmp_path, cmd, address, says):
+    """Every subcommand with --dask: a malformed address, or one where no scheduler listens,
+    is one line on stderr (nothing printed before it), exit 2, within seconds, no output."""
     t0 = time.perf_counter()
-    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", "optimize", "--gait", "walk",
-                        "--dask", address, "--out", str(tmp_path / "o")], capture_output=True,
-                       text=True, timeout=120)
+    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *cmd, "--dask", address,
+                        "--out", str(tmp_path / "o")], capture_output=True, text=True,
+                       timeout=120)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and says in lines[0], lines
-    assert time.perf_counter() - t0 < 15
+    assert time.perf_counter() - t0 < 15 and list(tmp_path.iterdir()) == []
 
 
 def test_an_on_screen_gl_backend_is_refused_in_one_line():

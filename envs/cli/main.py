@@ -95,9 +95,9 @@ def check_workers(a) -> None:
     dask = getattr(a, "dask", None)
     cores = os.cpu_count() or 1
     if dask not in (None, "local"):
-        from cpgbiped.cpg.optimize import check_dask_address
+        from cpgbiped.cpg.optimize import reach_dask_scheduler
 
-        check_dask_address(dask)
+        reach_dask_scheduler(dask)  # a malformed or unreachable address fails here, at once
     if n is not None and n > cores and (dask is None or dask == "local"):
         raise _input_error(f"--workers {n} is more than this machine's {cores} cores (each "
                            f"worker is a process of about 200 MB); use at most {cores}, or "
@@ -438,6 +438,7 @@ def cmd_optimize(a) -> int:
     from cpgbiped.cpg import io
 
     out_dir(a.out)
+    check_workers(a)
     gaits_ = primary_names(a.gait)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     check_bounds(*a.bounds)
@@ -485,6 +486,7 @@ def cmd_secondary(a) -> int:
     from cpgbiped.cpg.outdir import ResultDir
     from cpgbiped.cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
+    check_workers(a)
     if a.results is not None and not os.path.isdir(a.results):
         raise _input_error(f"--results {a.results!r} is not a folder of optimiser results")
     a.results = a.results or "out/optimize"
