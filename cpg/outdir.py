@@ -218,3 +218,20 @@ class ResultDir:
             os.close(self._lock_fd)
             self._lock_fd = None
         return False
+
+
+def run_checkpointed(out: str | os.PathLike, checkpoint: str, body):
+    """``body(rd, ckpt)`` inside a :class:`ResultDir` on ``out``, ``ckpt`` its checkpoint
+    (:meth:`ResultDir.state`); the files are committed when it returns. The checkpoint goes
+    after the commit, and after a failure on bad input (a run that fails must not block the
+    next one), but stays after an interrupt, so that the run can resume."""
+    with ResultDir(out) as rd:
+        ckpt = rd.state(checkpoint)
+        try:
+            result = body(rd, ckpt)
+        except InputError:
+            ckpt.unlink(missing_ok=True)
+            raise
+        rd.commit()
+    ckpt.unlink(missing_ok=True)
+    return result

@@ -872,9 +872,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--video-seconds", type=seconds_arg, default=8.0, help="seconds of video per gait")
     sp.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    def rollout_args(sp, rrd_required=False):
-        sp.add_argument("--gait", default="walk",
-                        help="the target the verdict checks: walk, run, jump or hop (default walk)")
+    def network_choice(sp, gait_help):
+        """--gait (what the command checks), and the network, preset and weights that drive
+        the body."""
+        sp.add_argument("--gait", default="walk", help=gait_help)
         sp.add_argument("--network", default="ml", choices=("ml", "hopf", "matsuoka"),
                         help="the network that drives the body (default ml: Morris-Lecar)")
         sp.add_argument("--preset", default=None,
@@ -882,6 +883,9 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--weights", metavar="FILE",
                         help="optimiser result JSON: its chosen (w_a, w_b, w_c), I_app and phi "
                              "replace the Morris-Lecar preset's")
+
+    def rollout_args(sp, rrd_required=False):
+        network_choice(sp, "the target the verdict checks: walk, run, jump or hop (default walk)")
         sp.add_argument("--seconds", type=seconds_arg, default=20.0,
                         help="simulated seconds measured after 2 s of settling (default 20)")
         sp.add_argument("--seed", type=seed_arg, default=None,
@@ -951,16 +955,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"))
 
     def network_args(sp):
-        sp.add_argument("--gait", default="walk",
-                        help="the gait checked in the conditions: walk, run, jump or hop "
-                             "(default walk)")
-        sp.add_argument("--network", default="ml", choices=("ml", "hopf", "matsuoka"),
-                        help="the network that drives the body (default ml: Morris-Lecar)")
-        sp.add_argument("--preset", default=None,
-                        help="the network's preset (default: the --gait; matsuoka: walk)")
-        sp.add_argument("--weights", metavar="FILE",
-                        help="optimiser result JSON: its chosen (w_a, w_b, w_c), I_app and phi "
-                             "replace the Morris-Lecar preset's")
+        network_choice(sp, "the gait checked in the conditions: walk, run, jump or hop "
+                           "(default walk)")
         sp.add_argument("--seed", type=seed_arg, default=None,
                         help="random initial CPG state from this seed (default: the preset's)")
         feedback_option(sp)
@@ -1253,7 +1249,6 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; every failure is one line on stderr: exit 2 for bad input, 1 for
     anything unexpected ("internal error"; the traceback only with --debug), 130 on Ctrl-C,
     143 on SIGTERM (handled like Ctrl-C)."""
-    import signal
     import threading
 
     previous = {}

@@ -309,20 +309,12 @@ def tune(settings: TuneSettings, rs, out: str | Path, runner, start: str | Path 
     :class:`cpg.optimize.RunSettings` (pop, gens, seed); ``start``: the gains file whose
     values the search starts from and keeps for what it does not search; ``progress(gen, n)``
     and ``note(text)`` (the best score so far) after every generation."""
-    from cpgbiped.cpg.outdir import ResultDir
+    from cpgbiped.cpg.outdir import run_checkpointed
 
     base, provenance = read_gains(start)
-    with ResultDir(out) as rd:
-        ckpt = rd.state(checkpoint_name(settings))
-        try:
-            result = _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command,
-                           progress, stop_after, note)
-        except InputError:
-            ckpt.unlink(missing_ok=True)  # a run that fails must not block the next one
-            raise
-        rd.commit()
-    ckpt.unlink(missing_ok=True)
-    return result
+    return run_checkpointed(out, checkpoint_name(settings), lambda rd, ckpt: _tune(
+        rd, ckpt, settings, rs, base, provenance, runner, start, command, progress, stop_after,
+        note))
 
 
 def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, progress,

@@ -25,7 +25,7 @@ import numpy as np
 from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.io import write_json
 from cpgbiped.cpg.optimize import RunSettings, run
-from cpgbiped.cpg.outdir import ResultDir
+from cpgbiped.cpg.outdir import run_checkpointed
 from cpgbiped.cpg.results import FORMAT
 from cpgbiped.cpg.search import plot_front, write_csv
 
@@ -72,16 +72,8 @@ def optimize_physics(gait: str, rs: RunSettings, out: str | Path, settings: Phys
     docstring). ``runner`` rolls out lists of trials (:mod:`cpgbiped.envs.simulation.trials`); the caller closes
     it. ``stop_after``: stop after that many generations of this call (tests of resuming)."""
     check_gait(gait)
-    with ResultDir(out) as rd:
-        ckpt = rd.state(checkpoint_name(gait))
-        try:
-            result = _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after)
-        except InputError:
-            ckpt.unlink(missing_ok=True)  # a run that fails must not block the next one
-            raise
-        rd.commit()
-    ckpt.unlink(missing_ok=True)
-    return result
+    return run_checkpointed(out, checkpoint_name(gait), lambda rd, ckpt: _optimize(
+        rd, ckpt, gait, rs, settings, runner, progress, stop_after))
 
 
 def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dict:
