@@ -3,7 +3,7 @@
 # (envs/control/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
 # order, each started from the one before. Every run is deterministic (its seed, its tuning
 # conditions), so the chain ends with the committed parameters, bit for bit; the last line
-# checks it. About 110 minutes on 2 cores. Usage:
+# checks it. About 140 minutes on 2 cores. Usage:
 #     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
 # then `cp OUT/final/gains.json envs/control/gains.json` makes the result the controller's gains.
 set -euo pipefail
@@ -29,6 +29,15 @@ stage r1 --gait run --conditions 2 --gens 300 --seed 4    # the run corner
 stage a1 --gait walk,run,jump,hop --conditions 3 --gens 420 --seed 10
 # Then a finer step (sigma 0.1) with a push among the conditions, so that a recovery is paid for.
 stage a2 --gait walk,run,jump,hop --conditions 4 --gens 140 --seed 11 --sigma 0.1
+# The double-support reflexes (push_off, knee_hold: 0 until now) alone, then the walk corner
+# with them, over 12 conditions: from the ninth on, other walk networks and the closed loop
+# (a walk stage over the first three conditions only reached a duty of 0.56 on the Table 3
+# network but fell with another walk network and with feedback).
+stage w2 --gait walk --only push_off,knee_hold --conditions 12 --gens 20 --pop 8 --sigma 0.3 --seed 23
+stage w3 --gait walk --conditions 12 --gens 60 --pop 16 --sigma 0.05 --seed 24
+# ... and a finer step over all 16 conditions: after w3 the walk fell under one of the four
+# last (another walk network at friction x1.25, or the closed loop with a push).
+stage w4 --gait walk --conditions 16 --gens 30 --pop 16 --sigma 0.03 --seed 26
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

@@ -149,3 +149,21 @@ def test_a_synchronous_rhythm_lifts_no_leg_on_its_own():
     assert feats[-1][0] < 0.1
     for leg in range(2):
         assert (modes[:, leg] == K.MODE_LIFT).any(), leg
+
+
+def test_double_support_reflexes_keep_the_trailing_foot_down():
+    """push_off and knee_hold act where the docstring says: in double support, on the trailing
+    leg. With both at 0 the trailing foot of the walk leaves the ground passively soon after the
+    other lands (its knee crouches); with them on, it stays down until its swing drive lifts it,
+    so the double support of the Table 2 walk grows. Both at their neutral 0 give the rollout
+    of a gains file written before they existed, bit for bit."""
+    from cpgbiped.envs.gaits.validate import validate
+
+    off = CONTROL.with_corner("alternating", push_off=0.0, knee_hold=0.0)
+    on = CONTROL.with_corner("alternating", push_off=0.3, knee_hold=1.0)
+    ds = {}
+    for name, p in (("off", off), ("on", on)):
+        s = validate(build("ml", "walk"), "walk", 8.0, params=p).summary()
+        assert not s["fell"], name
+        ds[name] = s["double_support"]
+    assert ds["on"] > ds["off"] + 0.02, ds

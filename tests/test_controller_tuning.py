@@ -90,10 +90,17 @@ def test_settings_refuse_bad_input():
         with pytest.raises(InputError):
             TuneSettings(("walk",), **bad)
     assert check_gaits("all") == tuple(CORNER_OF)
-    assert len(variables(TuneSettings(("jump", "hop"), search="both"))) == 2 * 22 + 5
+    assert len(variables(TuneSettings(("jump", "hop"), search="both"))) == 2 * 24 + 5
     assert len(variables(TuneSettings(("walk", "run", "jump", "hop"), search="shared"))) == 5
     with pytest.raises(InputError, match="unknown search"):
         TuneSettings(("walk",), search="everything")
+    # --only: a subset of the gains the search selects, by name
+    assert [v[0] for v in variables(TuneSettings(("walk",), only=("push_off", "knee_hold")))] \
+        == ["alternating.push_off", "alternating.knee_hold"]
+    with pytest.raises(InputError, match="unknown gain 'foo'"):
+        TuneSettings(("walk",), only=("foo",))
+    with pytest.raises(InputError, match="names no gain"):
+        TuneSettings(("walk",), only=("e_on",))  # a shared gain; --search corners
 
 
 class Quadratic(Problem):
@@ -187,3 +194,22 @@ def test_the_controller_loads_one_chain_of_tuning_runs():
         assert entry["started_from_sha256"] == ends
         ends = entry["result_sha256"]
     assert ends == params_sha256(p) and len(prov) > 1
+
+
+def test_tuning_walk_networks_are_walks_the_tests_never_use():
+    """The other walk networks of the tuning conditions are walks by the CPG classifier (the
+    paper's analysis), and none is one of the tests' weight sets."""
+    from cpgbiped.cpg.reproduce import run_preset
+    from cpgbiped.envs.search.controller_tuning import TUNING_WALKS, condition_trial
+    from tests.test_physics import WALK_FAST, WALK_SLOW
+
+    for w in TUNING_WALKS:
+        assert run_preset("walk", weights=w).classified_as == "walk", w
+        assert not any(np.allclose(w, t, atol=0.05) for t in (WALK_FAST, WALK_SLOW))
+    conds = tuning_conditions(16)
+    assert any("weights" in c for c in conds) and any(c.get("feedback", 0) > 0 for c in conds)
+    assert tuning_conditions(8) == conds[:8]  # the first eight are those of earlier runs
+    for c in conds:
+        if "weights" in c:  # another network for the walk only; the other presets keep theirs
+            assert condition_trial("walk", (), c).weights == tuple(c["weights"]["walk"])
+            assert condition_trial("run", (), c).weights is None

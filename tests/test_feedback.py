@@ -6,6 +6,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,7 +19,10 @@ from cpgbiped.envs.simulation.rollout import rollout
 # The rollouts recorded before the closed loop existed (commit 7c11c25): network, preset, CPG
 # seed, push (time s, impulse N s); 2.5 s each, stop_on_fall=False; every 5th row of their 45
 # columns (float64, little-endian), kept as the SHA-256 of those bytes: a rollout with K = 0
-# must reproduce them bit for bit.
+# must reproduce them bit for bit. They were recorded with the controller's gains of that time,
+# kept in tests/data/gains_before_double_support.json (the gains file before the double-support
+# reflexes were tuned; a file without them reads as their neutral 0).
+RECORDED_GAINS = Path(__file__).with_name("data") / "gains_before_double_support.json"
 RECORDED = {
     ("ml", "walk", None, None):
         "2c2cc3a005710811d6c6af4ae8a36d0248255f0e223c1b186811d32fda888a69",
@@ -42,8 +46,11 @@ def _rows(rec) -> np.ndarray:
 def test_zero_gain_reproduces_the_rows_recorded_before_feedback_existed(poses):
     import hashlib
 
+    from cpgbiped.envs.control.controller import read_gains
+
+    params = read_gains(RECORDED_GAINS)[0]
     for (kind, preset, seed, push), digest in RECORDED.items():
-        rec = rollout(build(kind, preset, seed=seed), 2.5, push=push, poses=poses,
+        rec = rollout(build(kind, preset, seed=seed), 2.5, params, push=push, poses=poses,
                       stop_on_fall=False, feedback=0.0)
         rows = np.ascontiguousarray(_rows(rec)[::5], dtype="<f8")
         assert rows.shape == (125, 45)

@@ -379,6 +379,11 @@ def cmd_optimize_physics(a) -> int:
     return 0
 
 
+def only_arg(text: str) -> tuple[str, ...]:
+    """``--only``: comma-separated gain names (empty: every gain the search selects)."""
+    return tuple(dict.fromkeys(x.strip() for x in str(text).split(",") if x.strip()))
+
+
 def cmd_tune(a) -> int:
     from cpgbiped.cpg.optimize import RunSettings
     from cpgbiped.envs.control.controller import GAINS_FILE
@@ -388,7 +393,7 @@ def cmd_tune(a) -> int:
     out_dir(a.out)
     check_workers(a)
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
-                            a.conditions, a.sigma)
+                            a.conditions, a.sigma, only_arg(a.only))
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1180,6 +1185,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")
+    sp.add_argument("--only", default="", metavar="GAINS",
+                    help="search only these gains (comma-separated names, e.g. "
+                         "push_off,knee_hold), at the corners or among the shared parameters "
+                         "that --gait and --search select")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
                     help="gains file to start from (default: the controller's, envs/control/gains.json)")
     sp.add_argument("--workers", type=count_arg(1), default=None,

@@ -29,7 +29,10 @@ from cpgbiped.cpg.feedback import outputs as fb_outputs
 SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
-           "kp_air", "kd_knee", "push", "swing_rest", "x_clear")
+           "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold")
+# Gains added after gains files had been written, with the value that reproduces the
+# controller before them (a file without them reads as that value; cpgbiped.envs.control).
+ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0}
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -154,9 +157,11 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest, x_clear) = (
+     swing_rest, x_clear, push_off, knee_hold) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
-        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21])
+        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23])
+    push_off = max(0.0, push_off)
+    knee_hold = _clip01(knee_hold)
     # Swing drive: own flexor, the other leg's extensor (crossed), or the silence of the own
     # extensor alone (swing_rest), all while the own extensor is silent.
     for i in range(2):
@@ -259,6 +264,14 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                 else:
                     u[i] = min(u[i] - b, 1.0)
         ref_x = sup_x
+        # Push-off in double support: the trailing leg (its foot behind the other), its
+        # extensor burst over, plantarflexes by push_off while the leading leg takes the
+        # weight, as the triceps surae does before a human toe-off; its toes stay down until
+        # its swing drive lifts it.
+        if n_support == 2:
+            tr = 0 if foot_x[0] < foot_x[1] else 1
+            if not stance_cmd[tr]:
+                u[2 + tr] = min(u[2 + tr] + push_off, 1.0)
     else:
         ref_x = com_x
 
@@ -285,6 +298,11 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             drive = e[i] * (1.0 - S[S_PUSHED + i])
             target = knee_crouch + (knee_ext - knee_crouch) * drive
             kp = kp_knee + (kp_push - kp_knee) * drive
+            # ... and the trailing leg's knee flexes no further (by knee_hold) while both feet
+            # are down: its crouch would lift the foot before the swing drive does.
+            if (n_support == 2 and not stance_cmd[i] and foot_x[i] < foot_x[1 - i]
+                    and knee[i] > target):
+                target += knee_hold * (knee[i] - target)
             k = kp * (target - knee[i]) - kd_knee * knee_rate[i] + push * drive
         else:
             # the swing drive tucks the leg while its foot is behind the hip (clearance); once

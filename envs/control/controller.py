@@ -54,7 +54,11 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    gait and network). A balance reflex adds to it on the ground (never replaces it):
    b = k_ax (x_com - x_sup) + k_av v_com with x_sup the mean centre of the support feet;
    b > 0 (centre of mass ahead) adds b to the support legs' extensors, b < 0 adds -b to their
-   flexors; clipped to [0, 1]. ``--no-ankle-drive`` sets ankle_gain = 0 (the reflex stays).
+   flexors; clipped to [0, 1]. In double support the trailing leg (its foot behind the other)
+   whose stance command is over adds push_off to its extensor: a push-off while the leading
+   leg takes the weight, as the human triceps surae does before toe-off, which keeps its toes
+   on the ground until its swing drive lifts it. ``--no-ankle-drive`` sets ankle_gain = 0 (the
+   reflexes stay).
 4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
    tau_torso = kp_t (pitch_d - pitch) - kd_t pitch_rate;
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
@@ -67,7 +71,10 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        stiffness kp = kp_knee + (kp_push - kp_knee) d_i,
        tau = kp (target - q) - kd_knee q_rate + push d_i
        (the extensor burst extends the leg - the push-off; outside it the knee yields to a
-       crouch that absorbs the landing and loads the next push);
+       crouch that absorbs the landing and loads the next push); in double support the
+       trailing leg without its stance command holds a share knee_hold of its knee's further
+       flexion, target += knee_hold (q - target) when q > target (a crouch there would lift
+       the foot before the swing drive does, and end the double support early);
    air and lift: target knee_land + (knee_swing - knee_land) g_i h_i,
        tau = kp_air (target - q) - kd_knee q_rate,
        h_i = clip((x_hip + x_clear - x_foot_i) / 0.05, 0, 1)
@@ -125,6 +132,8 @@ class Corner:
     push: float  # knee extension torque per unit of burst drive
     swing_rest: float  # swing drive while the leg's own extensor is silent
     x_clear: float  # m: a swinging foot this far ahead of the hip stops tucking and may land
+    push_off: float  # double support: ankle extensor activation added to the trailing leg
+    knee_hold: float  # double support: share of the trailing knee's further flexion held (0-1)
 
 
 @dataclass(frozen=True)
@@ -171,6 +180,9 @@ def params_from_dict(d: dict, what: str = "gains") -> ControlParams:
     """The inverse of :func:`params_to_dict`; every name must be there, finite, and known."""
     try:
         shared, corners = d["shared"], d["corners"]
+        # a file written before a gain was added reads as that gain's neutral value
+        corners = {c: {**kernel.ADDED_NEUTRAL, **v} if isinstance(v, dict) else v
+                   for c, v in corners.items()}
         if set(shared) != set(kernel.SHARED) or set(corners) != set(kernel.CORNERS) or any(
                 set(corners[c]) != set(kernel.BLENDED) for c in kernel.CORNERS):
             raise KeyError("names")
@@ -193,7 +205,8 @@ def gains_schema() -> dict:
     num = {"type": "number"}
 
     def block(names):
-        return {"type": "object", "required": list(names), "additionalProperties": False,
+        return {"type": "object", "additionalProperties": False,
+                "required": [n for n in names if n not in kernel.ADDED_NEUTRAL],
                 "properties": {n: num for n in names}}
 
     return {

@@ -80,7 +80,8 @@ CORNER_RANGES = dict(
     kp_sw=(0.3, 4.0), kd_sw=(0.02, 0.4), kf_t=(-1.0, 1.0), knee_ext=(-0.9, 0.0),
     knee_crouch=(-1.0, -0.02), knee_swing=(-1.4, -0.2), knee_land=(-0.9, 0.0),
     kp_knee=(0.3, 5.0), kp_push=(0.1, 5.0), kp_air=(0.3, 5.0), kd_knee=(0.02, 0.3),
-    push=(0.0, 1.0), swing_rest=(0.0, 1.0), x_clear=(-0.2, 0.3))
+    push=(0.0, 1.0), swing_rest=(0.0, 1.0), x_clear=(-0.2, 0.3), push_off=(0.0, 0.6),
+    knee_hold=(0.0, 1.0))
 # ... and of the shared parameters.
 SHARED_RANGES = dict(ankle_gain=(0.05, 0.35), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
                      w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06))
@@ -98,15 +99,48 @@ MAX_CONDITIONS = 16
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 
 
+# Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
+# (w_a, w_b, w_c) with the walk's I_app and phi that the CPG classifier names a walk, found by
+# a random scan of [-1, 1]^3 (numpy default_rng(5), the first 60 draws), periods 16.32 and
+# 10.47 model units (1.33 s and 0.85 s strides) around the Table 2 walk's 13.11. They are not
+# the tests' two walk networks (tests/test_physics.py: periods 9.57 and 16.63), so a
+# controller tuned with them is checked on networks it never saw.
+TUNING_WALKS = ((-0.566, 0.202, 0.772), (-0.039, -0.09, 0.334))
+
+
 def tuning_conditions(n: int) -> list[dict]:
     """The first ``n`` tuning conditions: ``cpg_seed`` (a random initial CPG state), and for
-    most of them a floor friction scale or a push (time s, impulse N s) on the torso."""
+    most of them a floor friction scale or a push (time s, impulse N s) on the torso. From the
+    ninth on, half of them drive the walk by another walk network (``weights``:
+    {"walk": (w_a, w_b, w_c)}, :data:`TUNING_WALKS`) and half close the loop (``feedback``:
+    the Morris-Lecar network's recommended gain, :mod:`cpgbiped.cpg.feedback`), so that the
+    gains are paid for serving a walk rhythm rather than one network, and the coupled system."""
+    from cpgbiped.cpg.feedback import RECOMMENDED
+
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
     extra = [{}, {"friction_scale": 0.8}, {"friction_scale": 1.25}, {"push": (5.5, 4.0)},
              {"push": (5.5, -4.0)}, {"friction_scale": 0.6}, {"friction_scale": 1.6},
              {"push": (4.5, 3.0)}]
-    return [{"cpg_seed": FIRST_TUNING_SEED + k, **extra[k % len(extra)]} for k in range(int(n))]
+    k_fb = float(RECOMMENDED["ml"])
+    variants = [{"weights": {"walk": TUNING_WALKS[0]}}, {"feedback": k_fb},
+                {"weights": {"walk": TUNING_WALKS[1]}}, {"feedback": k_fb, "friction_scale": 0.8},
+                {"weights": {"walk": TUNING_WALKS[0]}, "friction_scale": 1.25},
+                {"feedback": k_fb, "push": (5.5, 4.0)},
+                {"weights": {"walk": TUNING_WALKS[1]}, "friction_scale": 0.8},
+                {"feedback": k_fb, "push": (5.5, -4.0)}]
+    return [{"cpg_seed": FIRST_TUNING_SEED + k,
+             **(extra[k] if k < len(extra) else variants[k - len(extra)])} for k in range(int(n))]
+
+
+def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
+    """The rollout of ``gait``'s preset under one tuning condition (its own network's weights
+    when the condition names some for it)."""
+    w = cond.get("weights", {}).get(gait)
+    return ControlTrial(gait, control, cpg_seed=cond["cpg_seed"],
+                        friction_scale=cond.get("friction_scale", 1.0), push=cond.get("push"),
+                        weights=None if w is None else tuple(w),
+                        feedback=cond.get("feedback", 0.0))
 
 
 def check_gaits(text: str) -> tuple[str, ...]:
@@ -128,8 +162,14 @@ class TuneSettings:
     seconds: float = 10.0  # measured seconds per rollout, after SETTLE_S
     n_conditions: int = 6
     sigma: float = 0.15  # CMA-ES: initial step, in units of each variable's range
+    only: tuple[str, ...] = ()  # search only these gains (names of gains; empty: all)
 
     def __post_init__(self):
+        known = set(CORNER_RANGES) | set(SHARED_RANGES)
+        bad = [n for n in self.only if n not in known]
+        if bad:
+            raise InputError(f"unknown gain {', '.join(map(repr, bad))} in --only: use names "
+                             f"of {', '.join(sorted(known))}")
         check_gaits(",".join(self.gaits))
         if self.search not in SEARCHES:
             raise InputError(f"unknown search {self.search!r}: use {', '.join(SEARCHES)}")
@@ -145,6 +185,9 @@ class TuneSettings:
                     f"{cond['push'][0] - SETTLE_S:g} or --conditions {k} or fewer")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
+        if self.only and not variables(self):
+            raise InputError(f"--only {','.join(self.only)} names no gain that --search "
+                             f"{self.search} searches")
 
     @property
     def gait(self) -> str:  # the checkpoint header names the run by this
@@ -159,7 +202,10 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
             out += [(f"{CORNER_OF[g]}.{k}", lo, hi) for k, (lo, hi) in CORNER_RANGES.items()]
     if settings.search in ("shared", "both"):
         out += [(k, lo, hi) for k, (lo, hi) in SHARED_RANGES.items()]
+    if settings.only:
+        out = [v for v in out if v[0].split(".")[-1] in settings.only]
     return out
+
 
 
 def with_values(base: ControlParams, names: list[str], x) -> ControlParams:
@@ -234,7 +280,7 @@ class ControllerTuningProblem(Problem):
 
     def trials(self, x) -> list[ControlTrial]:
         P = tuple(params_array(with_values(self.base, self.names, x)).tolist())
-        return [ControlTrial(g, P, **c) for c in self.conditions for g in self.settings.gaits]
+        return [condition_trial(g, P, c) for c in self.conditions for g in self.settings.gaits]
 
     def evaluate_points(self, X) -> tuple[np.ndarray, list]:
         """(costs (P, n_conditions), summaries per point) of parameter vectors X."""
@@ -295,7 +341,12 @@ def params_sha256(p: ControlParams) -> str:
     which gains a run started from, whatever provenance the file carried."""
     import json
 
-    text = json.dumps(params_to_dict(p), sort_keys=True, separators=(",", ":"))
+    d = params_to_dict(p)
+    for gains in d["corners"].values():  # a gain added later, at its neutral value, is left
+        for name, neutral in kernel.ADDED_NEUTRAL.items():  # out: older files hash as before
+            if gains[name] == neutral:
+                del gains[name]
+    text = json.dumps(d, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -361,7 +412,7 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     write_json(rd.path("gains.json"), gains)
     write_csv(rd.path("tune_history.csv"), ["generation", "best_score", "median_score"],
               problem.history)
-    head = ["gait", "cpg_seed", "friction_scale", "push", "cost", "fell", "physical_gait",
+    head = ["gait", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost", "fell", "physical_gait",
             "speed_mps", "froude", "duty_left", "duty_right", "flight", "apex_height_m",
             "stride_cv", "ankle_excursion_deg"]
     rows = []
@@ -370,7 +421,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
         for j, g in enumerate(settings.gaits):
             s = summaries[k][c * n_g + j]
             rows.append([g, cond["cpg_seed"], cond.get("friction_scale", 1.0),
-                         cond.get("push", ""), round(rollout_cost(g, s, settings.seconds), 4),
+                         cond.get("push", ""), cond.get("weights", {}).get(g, ""),
+                         cond.get("feedback", 0.0), round(rollout_cost(g, s, settings.seconds), 4),
                          s["fell"], s["physical_gait"], _r(s["speed_mps"]), _r(s["froude"]),
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),

@@ -123,13 +123,17 @@ class ControlTrial:
     ``preset`` with its parameters, started from its Table 3 state or from a random one drawn
     from ``cpg_seed``, driving the body through the controller whose parameter array
     (:func:`cpgbiped.envs.control.controller.params_array`) is ``control``, under a condition (friction
-    scale, a push (time s, impulse N s))."""
+    scale, a push (time s, impulse N s)); ``weights`` (w_a, w_b, w_c) replace the preset's
+    coupling weights (another network of the preset's family), ``feedback`` is the gain K of
+    the body's feedback into the CPG (0: open loop)."""
 
     preset: str
     control: tuple
     cpg_seed: int | None = None
     friction_scale: float = 1.0
     push: tuple[float, float] | None = None
+    weights: tuple[float, float, float] | None = None
+    feedback: float = 0.0
 
 
 def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SETTLE_S,
@@ -144,10 +148,11 @@ def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SET
     from cpgbiped.envs.gaits.validate import measure_recording
 
     total = settle_s + seconds
-    net = build("ml", trial.preset, seed=trial.cpg_seed)
+    net = build("ml", trial.preset, seed=trial.cpg_seed,
+                weights=None if trial.weights is None else list(trial.weights))
     rec = rollout(net, total, params_from_array(np.asarray(trial.control, float)),
                   friction_scale=trial.friction_scale, push=trial.push,
-                  stop_on_fall=stop_on_fall, poses=False)
+                  stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback)
     s = measure_recording(net, trial.preset, rec, settle_s).summary()
     fell = bool(s["fell"]) or rec.unstable is not None
     s["fell"] = fell
