@@ -28,11 +28,12 @@ def test_froude_from_distance_and_duration(walk):
 
 
 def test_apex_from_the_recorded_com_height():
-    """The jump's apex against ballistics, not against the library's own algorithm: in a flight
+    """The hop's apex against ballistics, not against the library's own algorithm: in a flight
     the centre of mass rises v^2 / (2 g) above its take-off height, v its vertical speed at
     take-off. Flights here come from the raw contact forces (no debounce), 40 ms or longer;
-    take-off speeds from central differences of the recorded height."""
-    v = validate(build("ml", "jump"), "jump", 10.0)
+    take-off speeds from central differences of the recorded height. (The hop: the two-legged
+    gait that flies every cycle without a fall; the jump preset falls, README "Status".)"""
+    v = validate(build("ml", "hop"), "hop", 10.0)
     rec = v.recording
     sel = np.flatnonzero(rec.t >= v.settle_s)
     air = ~(rec.force > 1.0).any(axis=1)

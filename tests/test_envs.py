@@ -109,7 +109,6 @@ def test_fall_sensors_see_a_body_on_the_floor():
 
 
 ZERO_RESIDUAL_SHORTFALLS = {  # measured (README "Status"), as in tests/test_physics.py
-    "walk": ("named none: duty 0.51/0.54 below the walk's 0.55", False),
     "jump": ("falls at 10.2 s", True),
 }
 

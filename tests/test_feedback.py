@@ -19,19 +19,27 @@ from cpgbiped.envs.simulation.rollout import rollout
 # The rollouts recorded before the closed loop existed (commit 7c11c25): network, preset, CPG
 # seed, push (time s, impulse N s); 2.5 s each, stop_on_fall=False; every 5th row of their 45
 # columns (float64, little-endian), kept as the SHA-256 of those bytes: a rollout with K = 0
-# must reproduce them bit for bit. They were recorded with the controller's gains of that time,
+# must reproduce them bit for bit. The bits depend on the host: the machines of two sessions
+# gave two digests for the same code (the second machine: AVX2 and FMA, no AVX-512; presumably
+# numpy's and numba's CPU-specific code), so each case holds both; the second set was made on
+# that machine by commit bcd1fc2, before the double-support reflexes, and today's code gives
+# the same digests there. They were recorded with the controller's gains of that time,
 # kept in tests/data/gains_before_double_support.json (the gains file before the double-support
 # reflexes were tuned; a file without them reads as their neutral 0).
 RECORDED_GAINS = Path(__file__).with_name("data") / "gains_before_double_support.json"
-RECORDED = {
+RECORDED = {  # (digest on the first machine, digest on the AVX2 machine)
     ("ml", "walk", None, None):
-        "2c2cc3a005710811d6c6af4ae8a36d0248255f0e223c1b186811d32fda888a69",
+        ("2c2cc3a005710811d6c6af4ae8a36d0248255f0e223c1b186811d32fda888a69",
+         "a1cb8f9a2592830175718ff4f362932b5382c2258facafad7854cd58f60d775e"),
     ("ml", "jump", 3, (1.5, 4.0)):
-        "66a6d915dc8dca94bd3cc4cc7bb2acb503bbd30bd8f0d75dd2043452923ac0aa",
+        ("66a6d915dc8dca94bd3cc4cc7bb2acb503bbd30bd8f0d75dd2043452923ac0aa",
+         "53d39506fbf4d31fac1797b895b7c6afdea92b13ae436a288f42ab21c95041b7"),
     ("hopf", "run", None, None):
-        "245d4367aad358ccdfa1d43eb510a242fe9dceb762f14f079f59dd19617f58dc",
+        ("245d4367aad358ccdfa1d43eb510a242fe9dceb762f14f079f59dd19617f58dc",
+         "a7ab011c6c0c0f4eae907f4e122b7dc8d71bbe93696bcf2a8b0a8e93736a7691"),
     ("matsuoka", "walk", None, None):
-        "7d569344b86941f46d3732b1c2e7f57f1ffcf777d77b39e76b7a67bbba306475",
+        ("7d569344b86941f46d3732b1c2e7f57f1ffcf777d77b39e76b7a67bbba306475",
+         "b30194c1c6992cc68cfc44e46543a2f7d90ba87c805eff719695c00bb86f6149"),
 }
 
 
@@ -54,7 +62,7 @@ def test_zero_gain_reproduces_the_rows_recorded_before_feedback_existed(poses):
                       stop_on_fall=False, feedback=0.0)
         rows = np.ascontiguousarray(_rows(rec)[::5], dtype="<f8")
         assert rows.shape == (125, 45)
-        assert hashlib.sha256(rows.tobytes()).hexdigest() == digest, (kind, preset)
+        assert hashlib.sha256(rows.tobytes()).hexdigest() in digest, (kind, preset)
         assert rec.feedback_gain == 0.0 and not rec.feedback.any()
 
 
