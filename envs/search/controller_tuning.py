@@ -13,7 +13,9 @@ drive down to 0.1, and the run, which swings on it, could no longer lift a leg.
 
 Conditions. Every candidate drives each named preset under every tuning condition
 (:func:`tuning_conditions`): a random initial CPG state drawn from a seed of 1000 or more,
-some with another floor friction or a horizontal push on the torso. The tests and the README
+some with another floor friction or a horizontal push on the torso; from the ninth on, the
+walk driven by another walk network or the loop closed at the recommended feedback gain
+(:data:`TUNING_WALKS`). The tests and the README
 report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
