@@ -155,8 +155,9 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
     """push_off and knee_hold act where the docstring says: in double support, on the trailing
     leg. With both at 0 the trailing foot of the walk leaves the ground passively soon after the
     other lands (its knee crouches); with them on, it stays down until its swing drive lifts it,
-    so the double support of the Table 2 walk grows. Both at their neutral 0 give the rollout
-    of a gains file written before they existed, bit for bit."""
+    so the double support of the Table 2 walk grows. (That both at their neutral 0 give the
+    rollouts of a gains file written before they existed, bit for bit, is checked by
+    tests/test_feedback.py on its recorded rows.)"""
     from cpgbiped.envs.gaits.validate import validate
 
     off = CONTROL.with_corner("alternating", push_off=0.0, knee_hold=0.0)

@@ -250,6 +250,18 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             sup_x += foot_x[i]
         S[S_MODE + i] = mode[i]
 
+    # Double support: the trailing leg (its foot behind the other's) whose stance command is
+    # over gets the push-off and the knee hold below; -1 when there is none. With the feet
+    # exactly side by side (as when the body starts) the right leg counts as trailing for the
+    # push-off and no knee is held: the rule the gains were tuned with.
+    trailing = -1
+    side_by_side = False
+    if n_support == 2:
+        trailing = 0 if foot_x[0] < foot_x[1] else 1
+        side_by_side = foot_x[0] == foot_x[1]
+        if stance_cmd[trailing]:
+            trailing = -1
+
     # Ankles: the CPG's drive at one gain; a balance reflex adds to it on the ground.
     for c in range(4):
         u[c] = ankle_gain * a[c]
@@ -264,16 +276,13 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                 else:
                     u[i] = min(u[i] - b, 1.0)
         ref_x = sup_x
-        # Push-off in double support: the trailing leg (its foot behind the other), its
-        # extensor burst over, plantarflexes by push_off while the leading leg takes the
-        # weight, as the triceps surae does before a human toe-off; its toes stay down until
-        # its swing drive lifts it.
-        if n_support == 2:
-            tr = 0 if foot_x[0] < foot_x[1] else 1
-            if not stance_cmd[tr]:
-                u[2 + tr] = min(u[2 + tr] + push_off, 1.0)
     else:
         ref_x = com_x
+    # Push-off: the trailing leg plantarflexes by push_off while the leading leg takes the
+    # weight, as the triceps surae does before a human toe-off; its toes stay down until its
+    # swing drive lifts it.
+    if trailing >= 0:
+        u[2 + trailing] = min(u[2 + trailing] + push_off, 1.0)
 
     # Hips: legs off the ground (or lifting) place the foot; support legs hold the torso.
     theta = theta0 + c_v * com_v + c_d * (com_x - ref_x)
@@ -298,10 +307,9 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             drive = e[i] * (1.0 - S[S_PUSHED + i])
             target = knee_crouch + (knee_ext - knee_crouch) * drive
             kp = kp_knee + (kp_push - kp_knee) * drive
-            # ... and the trailing leg's knee flexes no further (by knee_hold) while both feet
-            # are down: its crouch would lift the foot before the swing drive does.
-            if (n_support == 2 and not stance_cmd[i] and foot_x[i] < foot_x[1 - i]
-                    and knee[i] > target):
+            # The trailing leg's knee flexes no further (by knee_hold) while both feet are
+            # down: its crouch would lift the foot before the swing drive does.
+            if i == trailing and not side_by_side and knee[i] > target:
                 target += knee_hold * (knee[i] - target)
             k = kp * (target - knee[i]) - kd_knee * knee_rate[i] + push * drive
         else:

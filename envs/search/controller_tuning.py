@@ -209,7 +209,6 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
     return out
 
 
-
 def with_values(base: ControlParams, names: list[str], x) -> ControlParams:
     """``base`` with the named parameters set to ``x``."""
     d = params_to_dict(base)
@@ -414,9 +413,9 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     write_json(rd.path("gains.json"), gains)
     write_csv(rd.path("tune_history.csv"), ["generation", "best_score", "median_score"],
               problem.history)
-    head = ["gait", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost", "fell", "physical_gait",
-            "speed_mps", "froude", "duty_left", "duty_right", "flight", "apex_height_m",
-            "stride_cv", "ankle_excursion_deg"]
+    head = ["gait", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost", "fell",
+            "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
+            "apex_height_m", "stride_cv", "ankle_excursion_deg"]
     rows = []
     n_g = len(settings.gaits)
     for c, cond in enumerate(problem.conditions):
@@ -424,7 +423,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
             s = summaries[k][c * n_g + j]
             rows.append([g, cond["cpg_seed"], cond.get("friction_scale", 1.0),
                          cond.get("push", ""), cond.get("weights", {}).get(g, ""),
-                         cond.get("feedback", 0.0), round(rollout_cost(g, s, settings.seconds), 4),
+                         cond.get("feedback", 0.0),
+                         round(rollout_cost(g, s, settings.seconds), 4),
                          s["fell"], s["physical_gait"], _r(s["speed_mps"]), _r(s["froude"]),
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
