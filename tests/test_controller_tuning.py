@@ -14,7 +14,8 @@ from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.optimize import RunSettings
 from cpgbiped.envs.gaits import gait_metrics as gm
 from cpgbiped.envs.control.controller import CONTROL, GAINS_FILE, read_gains
-from cpgbiped.envs.search.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, ROOT_GAINS_FILE, TuneSettings,
+from cpgbiped.envs.search.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, MAX_CONDITIONS,
+                                    ROOT_GAINS_FILE, TuneSettings,
                                     check_gaits, rollout_cost, target_speed, tune,
                                     tuning_conditions, variables)
 from cpgbiped.envs.gaits.criteria import CRITERIA
@@ -75,8 +76,8 @@ def test_tuning_conditions_are_disjoint_from_the_tests():
 
     test_seeds = {c.get("seed") for c in CONDITIONS + PERTURBATIONS}
     assert None in test_seeds and set(range(10, 20)) <= test_seeds
-    conds = tuning_conditions(16)
-    assert len({c["cpg_seed"] for c in conds}) == 16
+    conds = tuning_conditions(MAX_CONDITIONS)
+    assert len({c["cpg_seed"] for c in conds}) == MAX_CONDITIONS
     for c in conds:
         assert c["cpg_seed"] is not None and c["cpg_seed"] >= FIRST_TUNING_SEED
         assert c["cpg_seed"] not in test_seeds
@@ -85,7 +86,7 @@ def test_tuning_conditions_are_disjoint_from_the_tests():
 def test_settings_refuse_bad_input():
     with pytest.raises(InputError, match="unknown gait"):
         check_gaits("walk,skip")
-    for bad in (dict(algorithm="de"), dict(seconds=1.0), dict(n_conditions=17),
+    for bad in (dict(algorithm="de"), dict(seconds=1.0), dict(n_conditions=MAX_CONDITIONS + 1),
                 dict(sigma=0.0)):
         with pytest.raises(InputError):
             TuneSettings(("walk",), **bad)
@@ -209,7 +210,28 @@ def test_tuning_walk_networks_are_walks_the_tests_never_use():
     conds = tuning_conditions(16)
     assert any("weights" in c for c in conds) and any(c.get("feedback", 0) > 0 for c in conds)
     assert tuning_conditions(8) == conds[:8]  # the first eight are those of earlier runs
+    assert tuning_conditions(MAX_CONDITIONS)[:16] == conds  # and the first sixteen
     for c in conds:
         if "weights" in c:  # another network for the walk only; the other presets keep theirs
             assert condition_trial("walk", (), c).weights == tuple(c["weights"]["walk"])
             assert condition_trial("run", (), c).weights is None
+
+
+def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
+    """Conditions 17-20 roll every gait's Hopf preset out: the trial's CPG period is the Hopf
+    network's (the Morris-Lecar walk's differs: 13.1 model units at 12.3 per second, 1.07 s)."""
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.control.controller import CONTROL, params_array
+    from cpgbiped.envs.search.controller_tuning import condition_trial
+    from cpgbiped.envs.simulation.trials import run_control_trial
+
+    conds = tuning_conditions(MAX_CONDITIONS)
+    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4
+    control = tuple(params_array(CONTROL))
+    hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
+    ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)
+    assert hopf["cpg_period_s"] == pytest.approx(build("hopf", "walk").period_s(), rel=1e-3)
+    assert ml["cpg_period_s"] == pytest.approx(13.1 / 12.3, rel=0.02)
+    assert abs(hopf["cpg_period_s"] - ml["cpg_period_s"]) > 0.01
+    for g in ("run", "jump", "hop"):
+        assert condition_trial(g, control, conds[17]).network == "hopf"

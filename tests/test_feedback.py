@@ -215,9 +215,9 @@ def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fa
 
 # -- what issue 21 asks and the closed loop does not reach (measured, README "Feedback") ----
 @pytest.mark.xfail(raises=AssertionError, strict=True,
-                   reason="with feedback (K = 0.01) the jump falls in 13 of the 13 test "
-                          "conditions (open loop 12 of 13): the jump's shortfall of issue 20, "
-                          "which the feedback does not repair")
+                   reason="with feedback (K = 0.01) the jump falls in 12 of the 13 test "
+                          "conditions (open loop 10 of 13; Table 3 state at 4.1 s): the jump's "
+                          "shortfall of issue 20, which the feedback does not repair")
 def test_the_jump_survives_the_test_conditions_with_feedback():
     from tests.test_physics import CONDITIONS
 
@@ -246,7 +246,7 @@ def test_feedback_doubles_the_forward_push_envelope_or_reaches_half_a_newton_sec
 
 @pytest.mark.parametrize("preset", ["walk", "run", pytest.param("jump", marks=pytest.mark.xfail(
     raises=AssertionError, strict=True,
-    reason="with feedback the jump falls at 4.1 s (open loop at 15.4 s): the 2.1 s of cell "
+    reason="with feedback the jump falls at 4.1 s (open loop at 6.1 s): the 2.1 s of cell "
            "outputs after settling are too few for the classifier (named none; kept running "
            "after the fall, the closed-loop cells are named jump)")), "hop"])
 def test_the_cpg_classifier_names_each_preset_from_the_closed_loop_cells(preset):

@@ -1181,7 +1181,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=10.0,
                     help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
     sp.add_argument("--conditions", type=count_arg(1), default=6, metavar="N",
-                    help="tuning conditions per candidate (1-16, default 6)")
+                    help="tuning conditions per candidate (1-20, default 6)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")

@@ -97,7 +97,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 16
+MAX_CONDITIONS = 20
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 
 
@@ -116,7 +116,11 @@ def tuning_conditions(n: int) -> list[dict]:
     ninth on, half of them drive the walk by another walk network (``weights``:
     {"walk": (w_a, w_b, w_c)}, :data:`TUNING_WALKS`) and half close the loop (``feedback``:
     the Morris-Lecar network's recommended gain, :mod:`cpgbiped.cpg.feedback`), so that the
-    gains are paid for serving a walk rhythm rather than one network, and the coupled system."""
+    gains are paid for serving a walk rhythm rather than one network, and the coupled system.
+    From the seventeenth on, every gait is driven by the Hopf network's preset (``network``:
+    "hopf"), whose bursts have another shape (a walk's extensors burst for about 43% of the
+    cycle, the Morris-Lecar walk's for 30%), so that the gains serve a rhythm rather than one
+    network's waveform."""
     from cpgbiped.cpg.feedback import RECOMMENDED
 
     if not 1 <= int(n) <= MAX_CONDITIONS:
@@ -131,6 +135,9 @@ def tuning_conditions(n: int) -> list[dict]:
                 {"feedback": k_fb, "push": (5.5, 4.0)},
                 {"weights": {"walk": TUNING_WALKS[1]}, "friction_scale": 0.8},
                 {"feedback": k_fb, "push": (5.5, -4.0)}]
+    variants += [{"network": "hopf"}, {"network": "hopf", "friction_scale": 0.8},
+                 {"network": "hopf", "push": (5.5, 4.0)},
+                 {"network": "hopf", "friction_scale": 1.25}]
     return [{"cpg_seed": FIRST_TUNING_SEED + k,
              **(extra[k] if k < len(extra) else variants[k - len(extra)])} for k in range(int(n))]
 
@@ -142,7 +149,7 @@ def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
     return ControlTrial(gait, control, cpg_seed=cond["cpg_seed"],
                         friction_scale=cond.get("friction_scale", 1.0), push=cond.get("push"),
                         weights=None if w is None else tuple(w),
-                        feedback=cond.get("feedback", 0.0))
+                        feedback=cond.get("feedback", 0.0), network=cond.get("network", "ml"))
 
 
 def check_gaits(text: str) -> tuple[str, ...]:
@@ -413,7 +420,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     write_json(rd.path("gains.json"), gains)
     write_csv(rd.path("tune_history.csv"), ["generation", "best_score", "median_score"],
               problem.history)
-    head = ["gait", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost", "fell",
+    head = ["gait", "network", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost",
+            "fell",
             "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
             "apex_height_m", "stride_cv", "ankle_excursion_deg"]
     rows = []
@@ -421,7 +429,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     for c, cond in enumerate(problem.conditions):
         for j, g in enumerate(settings.gaits):
             s = summaries[k][c * n_g + j]
-            rows.append([g, cond["cpg_seed"], cond.get("friction_scale", 1.0),
+            rows.append([g, cond.get("network", "ml"), cond["cpg_seed"],
+                         cond.get("friction_scale", 1.0),
                          cond.get("push", ""), cond.get("weights", {}).get(g, ""),
                          cond.get("feedback", 0.0),
                          round(rollout_cost(g, s, settings.seconds), 4),

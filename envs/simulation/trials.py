@@ -125,7 +125,8 @@ class ControlTrial:
     (:func:`cpgbiped.envs.control.controller.params_array`) is ``control``, under a condition (friction
     scale, a push (time s, impulse N s)); ``weights`` (w_a, w_b, w_c) replace the preset's
     coupling weights (another network of the preset's family), ``feedback`` is the gain K of
-    the body's feedback into the CPG (0: open loop)."""
+    the body's feedback into the CPG (0: open loop); ``network`` the kind of network whose
+    preset drives the body (``cpg.network.KINDS``; weights are Morris-Lecar's only)."""
 
     preset: str
     control: tuple
@@ -134,6 +135,7 @@ class ControlTrial:
     push: tuple[float, float] | None = None
     weights: tuple[float, float, float] | None = None
     feedback: float = 0.0
+    network: str = "ml"
 
 
 def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SETTLE_S,
@@ -148,7 +150,7 @@ def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SET
     from cpgbiped.envs.gaits.validate import measure_recording
 
     total = settle_s + seconds
-    net = build("ml", trial.preset, seed=trial.cpg_seed,
+    net = build(trial.network, trial.preset, seed=trial.cpg_seed,
                 weights=None if trial.weights is None else list(trial.weights))
     rec = rollout(net, total, params_from_array(np.asarray(trial.control, float)),
                   friction_scale=trial.friction_scale, push=trial.push,
