@@ -88,10 +88,10 @@ def test_a_trial_is_deterministic_and_the_pool_gives_the_serial_results():
         pooled = pool(trials)
     finally:
         pool.close()
-    # (as JSON text: NaN == NaN there, as "the same number" means here)
-    same = lambda a, b: json.dumps([r.as_dict() for r in a]) == json.dumps([r.as_dict() for r in b])  # noqa: E731,E501
-    assert same(serial, pooled)
-    assert same([run_trial(trials[0], 3.0)], serial[:1])
+    # NaN equals NaN in numpy's assert_equal, as "the same number" means here
+    dicts = lambda results: [r.as_dict() for r in results]  # noqa: E731
+    np.testing.assert_equal(dicts(serial), dicts(pooled))
+    np.testing.assert_equal(dicts([run_trial(trials[0], 3.0)]), dicts(serial[:1]))
 
 
 def test_paper_run_is_feasible_and_the_push_matters():
@@ -140,14 +140,6 @@ def test_small_run_result_is_read_by_check_pareto(tmp_path):
         assert row["speed_mps"] == p["metrics"]["speed_mps"]
 
 
-def same(a, b) -> bool:
-    """Equal, with NaN equal to NaN (a spread over a single surviving rollout is NaN; NaN != NaN
-    would fail a comparison of two identical results)."""
-    import json
-
-    return json.dumps(a, sort_keys=True, default=str) == json.dumps(b, sort_keys=True, default=str)
-
-
 def test_resume_after_interrupt_gives_the_same_result(tmp_path):
     full = small(tmp_path, "full", SerialRunner(SMALL.seconds))
     with pytest.raises(KeyboardInterrupt):
@@ -156,8 +148,8 @@ def test_resume_after_interrupt_gives_the_same_result(tmp_path):
     assert (tmp_path / ".cut.run_physics.checkpoint.pkl").exists()
     resumed = small(tmp_path, "cut", SerialRunner(SMALL.seconds))
     assert resumed["resumed_from_generation"] == 1
-    for key in ("chosen", "pareto", "paper", "front"):
-        assert same(resumed[key], full[key]), key
+    for key in ("chosen", "pareto", "paper", "front"):  # NaN equals NaN (a spread over one
+        np.testing.assert_equal(resumed[key], full[key], err_msg=key)  # survivor is NaN)
 
 
 def test_dask_local_cluster_matches_the_process_pool(tmp_path):
@@ -172,7 +164,7 @@ def test_dask_local_cluster_matches_the_process_pool(tmp_path):
     finally:
         dask.close()
     for key in ("chosen", "pareto", "paper", "front"):
-        assert same(remote[key], local[key]), key
+        np.testing.assert_equal(remote[key], local[key], err_msg=key)
 
 
 def test_problem_rejects_bad_settings():

@@ -15,8 +15,8 @@ Conditions. Every candidate drives each named preset under every tuning conditio
 (:func:`tuning_conditions`): a random initial CPG state drawn from a seed of 1000 or more,
 some with another floor friction or a horizontal push on the torso; from the ninth on, the
 walk driven by another walk network or the loop closed at the recommended feedback gain
-(:data:`TUNING_WALKS`). The tests and the README
-report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
+(:data:`TUNING_WALKS`); from the seventeenth on, every preset driven by the Hopf network's.
+The tests and the README report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
 conditions.
@@ -421,8 +421,7 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     write_csv(rd.path("tune_history.csv"), ["generation", "best_score", "median_score"],
               problem.history)
     head = ["gait", "network", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost",
-            "fell",
-            "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
+            "fell", "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
             "apex_height_m", "stride_cv", "ankle_excursion_deg"]
     rows = []
     n_g = len(settings.gaits)
