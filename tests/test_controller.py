@@ -168,3 +168,27 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
         assert not s["fell"], name
         ds[name] = s["double_support"]
     assert ds["on"] > ds["off"] + 0.02, ds
+
+
+def test_landing_yield_lets_the_knee_give_before_it_pushes():
+    """land_yield withholds the extensor burst's knee drive after a landing until the knee's
+    flexion stops. At 0 (the committed gains) the run's knee extends at once when it lands
+    in its burst (a piston); at 1 the leg first gives: its knee flexes further in the first
+    60 ms after touchdown. (At its neutral 0 it leaves the rollouts of older gains files
+    unchanged, bit for bit: tests/test_feedback.py's recorded rows.)"""
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    give = {}
+    for y in (0.0, 1.0):
+        p = CONTROL.with_corner("alternating_coactive", land_yield=y)
+        rec = rollout(build("ml", "run"), 5.0, p, poses=False, stop_on_fall=False)
+        n = int(round(0.06 / (rec.t[1] - rec.t[0])))
+        flex = []
+        for leg, knee in ((0, 1), (1, 4)):  # joints: hip, knee, ankle per leg
+            down = rec.contact[:, leg] > 0.5
+            for k in np.flatnonzero(~down[:-1] & down[1:]) + 1:
+                if rec.t[k] >= 2.0:
+                    flex.append(rec.joints[k, knee] - rec.joints[k:k + n, knee].min())
+        assert len(flex) >= 8, (y, len(flex))
+        give[y] = float(np.mean(flex))
+    assert give[0.0] < 0.02 and give[1.0] > 0.03, give

@@ -102,6 +102,12 @@ def test_settings_refuse_bad_input():
         TuneSettings(("walk",), only=("foo",))
     with pytest.raises(InputError, match="names no gain"):
         TuneSettings(("walk",), only=("e_on",))  # a shared gain; --search corners
+    # a gain added after the chain's all-gain stages (land_yield) is searched only when named,
+    # so that those stages keep their 24 variables per corner and reproduce
+    assert "alternating_coactive.land_yield" not in [v[0] for v in variables(
+        TuneSettings(("run",)))]
+    assert [v[0] for v in variables(TuneSettings(("run",), only=("land_yield",)))] == [
+        "alternating_coactive.land_yield"]
 
 
 class Quadratic(Problem):
@@ -177,8 +183,9 @@ def test_small_run_writes_a_gains_file_and_resumes_identically(tmp_path, algorit
 
 def test_the_controller_loads_one_chain_of_tuning_runs():
     """The committed gains are the end of a chain that starts at the hand-set root file: each
-    cpgbiped tune run started from the parameters the one before it ended with (SHA-256 of
-    the values), with its command, seed and tuning conditions recorded, and the last one
+    cpgbiped tune run (or gains set by hand, with what and why) started from the parameters
+    the one before it ended with (SHA-256 of the values), with its command, seed and tuning
+    conditions recorded, and the last one
     ended with exactly the parameters the controller loads (scripts/tune_gains.sh re-runs
     the chain)."""
     from cpgbiped.envs.search.controller_tuning import ROOT_GAINS_FILE, params_sha256
@@ -189,9 +196,12 @@ def test_the_controller_loads_one_chain_of_tuning_runs():
     assert root_prov[0].get("hand_set") and prov[0] == root_prov[0]
     ends = params_sha256(root)
     for entry in prov[1:]:
-        assert entry["command"].startswith("cpgbiped tune")
-        assert isinstance(entry["seed"], int) and entry["conditions"] == json.loads(
-            json.dumps(tuning_conditions(entry["settings"]["n_conditions"])))
+        if entry.get("hand_set"):  # a link set by hand (set_by_hand): what, and why
+            assert entry["set"] and entry["note"] and "tune_gains.sh" in entry["command"]
+        else:
+            assert entry["command"].startswith("cpgbiped tune")
+            assert isinstance(entry["seed"], int) and entry["conditions"] == json.loads(
+                json.dumps(tuning_conditions(entry["settings"]["n_conditions"])))
         assert entry["started_from_sha256"] == ends
         ends = entry["result_sha256"]
     assert ends == params_sha256(p) and len(prov) > 1
@@ -235,3 +245,20 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     assert abs(hopf["cpg_period_s"] - ml["cpg_period_s"]) > 0.01
     for g in ("run", "jump", "hop"):
         assert condition_trial(g, control, conds[17]).network == "hopf"
+
+
+def test_gains_set_by_hand_are_a_link_of_the_chain(tmp_path):
+    """set_by_hand changes exactly the named gains, and records the change as a link: the
+    SHA-256 of the values it started from and of those it wrote."""
+    from cpgbiped.envs.search.controller_tuning import params_sha256, set_by_hand
+
+    out = tmp_path / "g.json"
+    set_by_hand(GAINS_FILE, {"alternating_coactive.k_av": 0.25, "e_on": 0.45}, out, "a test")
+    p, prov = read_gains(out)
+    from dataclasses import replace
+
+    assert p == replace(CONTROL, e_on=0.45).with_corner("alternating_coactive", k_av=0.25)
+    assert prov[-1]["started_from_sha256"] == params_sha256(CONTROL)
+    assert prov[-1]["result_sha256"] == params_sha256(p) != params_sha256(CONTROL)
+    with pytest.raises(InputError, match="unknown gain"):
+        set_by_hand(GAINS_FILE, {"alternating.no_such_gain": 1.0}, out, "bad")

@@ -1188,7 +1188,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--only", default="", metavar="GAINS",
                     help="search only these gains (comma-separated names, e.g. "
                          "push_off,knee_hold), at the corners or among the shared parameters "
-                         "that --gait and --search select")
+                         "that --gait and --search select; land_yield is searched only when "
+                         "named here")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
                     help="gains file to start from (default: the controller's, envs/control/gains.json)")
     sp.add_argument("--workers", type=count_arg(1), default=None,

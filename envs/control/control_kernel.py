@@ -29,10 +29,11 @@ from cpgbiped.cpg.feedback import outputs as fb_outputs
 SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
-           "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold")
+           "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
+           "land_yield")
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
-ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0}
+ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0}
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -51,7 +52,10 @@ S_LAST_GROUND, S_PUSHED, S_SWUNG, S_MODE = 0, 4, 6, 8
 S_LAST_T, S_C_LR, S_V_L, S_V_R, S_SYNC, S_C_FE, S_V_F, S_V_E, S_COACT = 10, 11, 12, 13, 14, 15, 16, 17, 18
 S_GROUNDED_IN_BURST = 19  # pair: the leg stood on the ground during its present burst
 S_AIRBORNE, S_SWING_DONE = 21, 23  # pairs: the swinging foot has left the ground; lifted in this drive
-S_SIZE = 25
+# S_YIELD, pair: the landing's yield (0: none; 1: armed, the leg is off the ground or has just
+# landed; 2: landed and its knee is flexing). Cleared when the knee's flexion stops.
+S_YIELD = 25
+S_SIZE = 27
 TAU_FEATURE = 0.5  # s: time constant of those running averages
 # Leg modes (S_MODE), for recordings and tests.
 MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
@@ -157,11 +161,12 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest, x_clear, push_off, knee_hold) = (
+     swing_rest, x_clear, push_off, knee_hold, land_yield) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
-        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23])
+        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24])
     push_off = max(0.0, push_off)
     knee_hold = _clip01(knee_hold)
+    land_yield = _clip01(land_yield)
     # Swing drive: own flexor, the other leg's extensor (crossed), or the silence of the own
     # extensor alone (swing_rest), all while the own extensor is silent.
     for i in range(2):
@@ -300,11 +305,26 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             if mode[i] == MODE_SUPPORT:
                 tau_hip[i] = share
 
+    # The landing's yield: a leg that lands first lets its knee flex (the crouch: the leg a
+    # spring that stores the fall) and takes up its burst's extension only once the flexion
+    # has stopped; land_yield is the share of the drive withheld meanwhile (0: the knee extends
+    # at once when it lands in its burst).
+    for i in range(2):
+        if mode[i] != MODE_SUPPORT:
+            S[S_YIELD + i] = 1.0
+        elif S[S_YIELD + i] > 1.5:
+            if knee_rate[i] >= 0.0:
+                S[S_YIELD + i] = 0.0
+        elif S[S_YIELD + i] > 0.5 and knee_rate[i] < 0.0:
+            S[S_YIELD + i] = 2.0
+
     # Knees: support legs extend with the extensor burst (once per burst) and crouch outside
     # it; legs in the air flex with the swing drive and extend to land without it.
     for i in range(2):
         if mode[i] == MODE_SUPPORT:
             drive = e[i] * (1.0 - S[S_PUSHED + i])
+            if S[S_YIELD + i] > 0.5:
+                drive *= 1.0 - land_yield
             target = knee_crouch + (knee_ext - knee_crouch) * drive
             kp = kp_knee + (kp_push - kp_knee) * drive
             # The trailing leg's knee flexes no further (by knee_hold) while both feet are

@@ -71,7 +71,9 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        stiffness kp = kp_knee + (kp_push - kp_knee) d_i,
        tau = kp (target - q) - kd_knee q_rate + push d_i
        (the extensor burst extends the leg - the push-off; outside it the knee yields to a
-       crouch that absorbs the landing and loads the next push); in double support the
+       crouch that absorbs the landing and loads the next push); after a landing the drive
+       is d_i (1 - land_yield) until the knee's flexion stops (knee rate >= 0 after flexing):
+       the leg first gives, then pushes; in double support the
        trailing leg without its stance command holds a share knee_hold of its knee's further
        flexion, target += knee_hold (q - target) when q > target (a crouch there would lift
        the foot before the swing drive does, and end the double support early);
@@ -134,6 +136,8 @@ class Corner:
     x_clear: float  # m: a swinging foot this far ahead of the hip stops tucking and may land
     push_off: float  # double support: ankle extensor activation added to the trailing leg
     knee_hold: float  # double support: share of the trailing knee's further flexion held (0-1)
+    land_yield: float  # share of the knee's extension drive withheld after a landing until
+    # the knee stops flexing (0-1)
 
 
 @dataclass(frozen=True)

@@ -83,7 +83,10 @@ CORNER_RANGES = dict(
     knee_crouch=(-1.0, -0.02), knee_swing=(-1.4, -0.2), knee_land=(-0.9, 0.0),
     kp_knee=(0.3, 5.0), kp_push=(0.1, 5.0), kp_air=(0.3, 5.0), kd_knee=(0.02, 0.3),
     push=(0.0, 1.0), swing_rest=(0.0, 1.0), x_clear=(-0.2, 0.3), push_off=(0.0, 0.6),
-    knee_hold=(0.0, 1.0))
+    knee_hold=(0.0, 1.0), land_yield=(0.0, 1.0))
+# Gains added after the stages of scripts/tune_gains.sh that search every gain were run: a
+# search takes them only when --only names them, so that those stages reproduce.
+OPT_IN = ("land_yield",)
 # ... and of the shared parameters.
 SHARED_RANGES = dict(ankle_gain=(0.05, 0.35), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
                      w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06))
@@ -213,6 +216,8 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
         out += [(k, lo, hi) for k, (lo, hi) in SHARED_RANGES.items()]
     if settings.only:
         out = [v for v in out if v[0].split(".")[-1] in settings.only]
+    else:
+        out = [v for v in out if v[0].split(".")[-1] not in OPT_IN]
     return out
 
 
@@ -446,3 +451,30 @@ def _r(x, nd: int = 4):
         return round(float(x), nd)
     except (TypeError, ValueError):
         return ""
+
+
+def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, why: str) -> dict:
+    """A link of a tuning chain that is not a search: ``start``'s gains with ``values``
+    ({"<corner>.<gain>" or a shared name: value}) set by hand, written to ``out`` with a
+    provenance entry (hand_set, what was set and why, and the SHA-256 of the values it started
+    from and ended with, as a search's entry has). Used by scripts/tune_gains.sh where a search
+    needs a start outside the basin the previous link ended in."""
+    from cpgbiped.cpg.io import write_json
+
+    base, provenance = read_gains(start)
+    names = list(values)
+    known = {v[0] for v in variables(TuneSettings(gaits=GAITS, search="both", only=tuple(
+        n.split(".")[-1] for n in names)))}
+    bad = [n for n in names if n not in known]
+    if bad:
+        raise InputError(f"unknown gain {', '.join(map(repr, bad))}: use <corner>.<gain> or a "
+                         f"shared name")
+    p = with_values(base, names, [values[n] for n in names])
+    entry = {"part": sorted({n.split(".")[0] for n in names if "." in n}) or ["shared"],
+             "hand_set": True, "set": {n: float(values[n]) for n in names}, "note": why,
+             "command": f"scripts/tune_gains.sh: set by hand ({', '.join(names)})",
+             "started_from": str(start), "started_from_sha256": params_sha256(base),
+             "result_sha256": params_sha256(p)}
+    gains = {"format": GAINS_FORMAT, **params_to_dict(p), "provenance": list(provenance) + [entry]}
+    write_json(out, gains)
+    return gains
