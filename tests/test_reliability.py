@@ -706,7 +706,9 @@ def test_render_s_video_pictures_and_recording_land_together(tmp_path, sig):
     assert len(old) == 6 and set(old) == set(new) and all(old[f][1] != new[f] for f in
                                                           ("r.mp4", "r_chrono.png"))
     landed = 0
-    for frac in (0.3, 0.5, 0.7, 0.85, 0.95, 1.02):
+    # eight moments, five of them in the first 70% of the run: this VM's speed drifts, and a
+    # run faster than the timing runs once let only 2 of 6 moments (from 30%) land inside it
+    for frac in (0.2, 0.3, 0.4, 0.5, 0.7, 0.85, 0.95, 1.02):
         p = subprocess.Popen(args(2), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         time.sleep(frac * total)
         p.send_signal(sig)
