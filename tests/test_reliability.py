@@ -38,6 +38,20 @@ def snapshot(folder) -> dict:
 NOTES = "a file of the user's that no run writes: it must survive every swap\n"
 
 
+@pytest.fixture(autouse=True, scope="module")
+def interrupts_reach_the_children():
+    """The interrupt tests send SIGINT to child processes. A shell that starts a job in the
+    background (non-interactive, without job control) starts it with SIGINT ignored, and an
+    ignored signal stays ignored across exec: no child would ever see the Ctrl-C. Here the test
+    process handles SIGINT (which exec resets to the default in a child), however the suite was
+    launched; a user's `nohup`-style ignore is left to the CLI, which respects it."""
+    before = signal.getsignal(signal.SIGINT)
+    if before == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
 @pytest.fixture(scope="module")
 def old_and_new(tmp_path_factory):
     """The complete result sets of two optimize runs (seeds 1 and 2) into folders that also
