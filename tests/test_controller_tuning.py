@@ -197,7 +197,7 @@ def test_the_controller_loads_one_chain_of_tuning_runs():
     ends = params_sha256(root)
     for entry in prov[1:]:
         if entry.get("hand_set"):  # a link set by hand (set_by_hand): what, and why
-            assert entry["set"] and entry["note"] and "tune_gains.sh" in entry["command"]
+            assert entry["set"] and entry["note"] and entry["command"].startswith("set by hand")
         else:
             assert entry["command"].startswith("cpgbiped tune")
             assert isinstance(entry["seed"], int) and entry["conditions"] == json.loads(
@@ -250,13 +250,13 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
 def test_gains_set_by_hand_are_a_link_of_the_chain(tmp_path):
     """set_by_hand changes exactly the named gains, and records the change as a link: the
     SHA-256 of the values it started from and of those it wrote."""
+    from dataclasses import replace
+
     from cpgbiped.envs.search.controller_tuning import params_sha256, set_by_hand
 
     out = tmp_path / "g.json"
     set_by_hand(GAINS_FILE, {"alternating_coactive.k_av": 0.25, "e_on": 0.45}, out, "a test")
     p, prov = read_gains(out)
-    from dataclasses import replace
-
     assert p == replace(CONTROL, e_on=0.45).with_corner("alternating_coactive", k_av=0.25)
     assert prov[-1]["started_from_sha256"] == params_sha256(CONTROL)
     assert prov[-1]["result_sha256"] == params_sha256(p) != params_sha256(CONTROL)

@@ -457,8 +457,8 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
     """A link of a tuning chain that is not a search: ``start``'s gains with ``values``
     ({"<corner>.<gain>" or a shared name: value}) set by hand, written to ``out`` with a
     provenance entry (hand_set, what was set and why, and the SHA-256 of the values it started
-    from and ended with, as a search's entry has). Used by scripts/tune_gains.sh where a search
-    needs a start outside the basin the previous link ended in."""
+    from and ended with, as a search's entry has), for a search that needs a start outside
+    the basin the previous link ended in (scripts/tune_run_experiment.sh)."""
     from cpgbiped.cpg.io import write_json
 
     base, provenance = read_gains(start)
@@ -472,7 +472,7 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
     p = with_values(base, names, [values[n] for n in names])
     entry = {"part": sorted({n.split(".")[0] for n in names if "." in n}) or ["shared"],
              "hand_set": True, "set": {n: float(values[n]) for n in names}, "note": why,
-             "command": f"scripts/tune_gains.sh: set by hand ({', '.join(names)})",
+             "command": f"set by hand ({', '.join(names)})",
              "started_from": str(start), "started_from_sha256": params_sha256(base),
              "result_sha256": params_sha256(p)}
     gains = {"format": GAINS_FORMAT, **params_to_dict(p), "provenance": list(provenance) + [entry]}
