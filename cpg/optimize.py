@@ -386,6 +386,8 @@ def run(problem: _BatchedProblem, rs: RunSettings, checkpoint: str | Path | None
             "settings": asdict(problem.settings)}
     if algorithm is not None:
         meta["algorithm"] = type(algorithm).__name__
+    if hasattr(problem, "resume_key"):  # what else a resumed run must share with the first
+        meta["resume_key"] = problem.resume_key()
     meta.pop("checkpoint_every")
     ckpt = Path(checkpoint) if checkpoint else None
     resumed = None

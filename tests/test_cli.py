@@ -43,6 +43,9 @@ def test_help_reads_like_a_manual():
     (["reproduce", "--dt", "-1"], "must be an RK4 step in [0.001, 0.1]"),
     (["hopf", "--beta", "nan"], "must be finite"),
     (["frobnicate"], "invalid choice"),
+    (["tune", "--gait", "walk", "--conditions", "1-8,25"], "numbered 1-24"),
+    (["tune", "--gait", "walk", "--conditions", "8-1"], "numbered 1-24"),
+    (["tune", "--gait", "walk", "--only", "synchronous.push"], "names no gain"),
 ])
 def test_bad_input_one_line_nonzero(args, msg):
     r = run(*args)

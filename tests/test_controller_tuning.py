@@ -108,6 +108,54 @@ def test_settings_refuse_bad_input():
         TuneSettings(("run",)))]
     assert [v[0] for v in variables(TuneSettings(("run",), only=("land_yield",)))] == [
         "alternating_coactive.land_yield"]
+    # one corner's gains, scored on more gaits: --gait walk,jump --only 'synchronous.*' searches
+    # the jump's corner (its 24 gains; land_yield still only when named) and scores the walk too
+    names = [v[0] for v in variables(TuneSettings(("walk", "jump"), only=("synchronous.*",)))]
+    assert len(names) == 24 and all(n.startswith("synchronous.") for n in names)
+    assert "synchronous.land_yield" not in names
+    assert [v[0] for v in variables(TuneSettings(("walk", "jump"), only=(
+        "synchronous.theta0", "alternating.push_off")))] == ["alternating.push_off",
+                                                           "synchronous.theta0"]
+    with pytest.raises(InputError, match="unknown gain 'synchronous.foo'"):
+        TuneSettings(("jump",), only=("synchronous.foo",))
+    with pytest.raises(InputError, match="names no gain"):
+        TuneSettings(("walk",), only=("synchronous.*",))  # the walk's search has no such corner
+
+
+def test_conditions_can_be_picked_by_number():
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-24,
+    reversed ranges and text are refused."""
+    from cpgbiped.envs.search.controller_tuning import condition_ids
+
+    ids = condition_ids("1-8,21-24")
+    assert ids == (1, 2, 3, 4, 5, 6, 7, 8, 21, 22, 23, 24)
+    s = TuneSettings(("walk",), n_conditions=len(ids), condition_ids=ids)
+    every = tuning_conditions(MAX_CONDITIONS)
+    assert s.conditions() == every[:8] + every[20:]
+    assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
+    assert condition_ids("3,3,1") == (3, 1)
+    for bad in ("0-3", "20-25", "5-2", "a", "1-", ""):
+        with pytest.raises(InputError):
+            condition_ids(bad)
+    with pytest.raises(InputError):
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(25,))
+
+
+def test_conditions_21_to_24_start_the_walk_network_in_a_jumps_rhythm():
+    """From the seeds of conditions 21-24 the Table 2 walk network's extensors burst together
+    over its first seconds (overlap <e_L e_R> / sqrt(<e_L^2><e_R^2>) over 0.5-3 s above 0.4: a
+    jump's rhythm, which the walk's settled antiphase has at 0), and from none of the first
+    sixteen conditions' open-loop Table 2 walks; by the end of 20 s every one of them walks
+    (overlap near 0)."""
+    from cpgbiped.envs.search.controller_tuning import extensor_overlap
+
+    conds = tuning_conditions(MAX_CONDITIONS)
+    for c in conds[20:]:
+        assert extensor_overlap("walk", c["cpg_seed"]) > 0.4, c
+        assert extensor_overlap("walk", c["cpg_seed"], 17.0, 20.0) < 0.05, c
+    for c in conds[:16]:
+        if "weights" not in c and "feedback" not in c:
+            assert extensor_overlap("walk", c["cpg_seed"]) < 0.4, c
 
 
 class Quadratic(Problem):
@@ -169,6 +217,14 @@ def test_small_run_writes_a_gains_file_and_resumes_identically(tmp_path, algorit
     b = json.loads((tmp_path / "cut" / "gains.json").read_text())
     assert a["corners"] == b["corners"] and a["shared"] == b["shared"]
     assert full["entry"]["cost"] == resumed["entry"]["cost"]
+    # a checkpoint resumes only the run that wrote it: the same settings from other starting
+    # gains (or other conditions behind the same numbers) start nothing from it
+    with pytest.raises(KeyboardInterrupt):
+        _small_tune(tmp_path / "other", stop_after=1, algorithm=algorithm)
+    s = TuneSettings(("hop",), algorithm=algorithm, seconds=2.0, n_conditions=1)
+    with pytest.raises(InputError, match="other settings"):
+        tune(s, RunSettings(**SMALL), tmp_path / "other", SerialRunner(2.0), start=GAINS_FILE,
+             command="test")
     # the file is a gains file the controller reads; only the hop's corner moved
     p, prov = read_gains(tmp_path / "full" / "gains.json")
     assert prov[-1]["command"] == "test" and prov[-1]["seed"] == 5
@@ -200,8 +256,11 @@ def test_the_controller_loads_one_chain_of_tuning_runs():
             assert entry["set"] and entry["note"] and entry["command"].startswith("set by hand")
         else:
             assert entry["command"].startswith("cpgbiped tune")
+            ids = entry["settings"].get("condition_ids") or range(
+                1, entry["settings"]["n_conditions"] + 1)
+            every = tuning_conditions(MAX_CONDITIONS)
             assert isinstance(entry["seed"], int) and entry["conditions"] == json.loads(
-                json.dumps(tuning_conditions(entry["settings"]["n_conditions"])))
+                json.dumps([every[k - 1] for k in ids]))
         assert entry["started_from_sha256"] == ends
         ends = entry["result_sha256"]
     assert ends == params_sha256(p) and len(prov) > 1
@@ -236,7 +295,7 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4
+    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 4
     control = tuple(params_array(CONTROL))
     hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
     ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)

@@ -379,6 +379,24 @@ def cmd_optimize_physics(a) -> int:
     return 0
 
 
+def conditions_arg(text: str) -> tuple[int, tuple[int, ...]]:
+    """``--conditions``: N (the first N tuning conditions) or numbers and ranges (1-8,21-24);
+    returns (how many, their numbers or () for the first N)."""
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.envs.search.controller_tuning import MAX_CONDITIONS, condition_ids
+
+    try:
+        if text.strip().isdigit():
+            n = int(text)
+            if not 1 <= n <= MAX_CONDITIONS:
+                raise InputError(f"must be 1-{MAX_CONDITIONS}, got {n}")
+            return n, ()
+        ids = condition_ids(text)
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    return len(ids), ids
+
+
 def only_arg(text: str) -> tuple[str, ...]:
     """``--only``: comma-separated gain names (empty: every gain the search selects)."""
     return tuple(dict.fromkeys(x.strip() for x in str(text).split(",") if x.strip()))
@@ -392,8 +410,9 @@ def cmd_tune(a) -> int:
 
     out_dir(a.out)
     check_workers(a)
+    n_cond, ids = a.conditions
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
-                            a.conditions, a.sigma, only_arg(a.only))
+                            n_cond, a.sigma, only_arg(a.only), ids)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1180,16 +1199,20 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seed", type=seed_arg, default=0, help="random seed (default 0)")
     sp.add_argument("--seconds", type=seconds_arg, default=10.0,
                     help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
-    sp.add_argument("--conditions", type=count_arg(1), default=6, metavar="N",
-                    help="tuning conditions per candidate (1-20, default 6)")
+    sp.add_argument("--conditions", type=conditions_arg, default=(6, ()), metavar="N",
+                    help="tuning conditions per candidate: the first N (1-24, default 6), "
+                         "or numbers and ranges such as 1-8,21-24 (21-24: CPG states "
+                         "from which the walk network starts in a jump's rhythm)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")
     sp.add_argument("--only", default="", metavar="GAINS",
                     help="search only these gains (comma-separated names, e.g. "
                          "push_off,knee_hold), at the corners or among the shared parameters "
-                         "that --gait and --search select; land_yield is searched only when "
-                         "named here")
+                         "that --gait and --search select; a name may be one corner's "
+                         "(synchronous.theta0) or all of it (synchronous.*), so that "
+                         "--gait walk,jump --only 'synchronous.*' searches the jump's corner "
+                         "scored on both gaits; land_yield is searched only when named here")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
                     help="gains file to start from (default: the controller's, envs/control/gains.json)")
     sp.add_argument("--workers", type=count_arg(1), default=None,

@@ -100,8 +100,17 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 20
+MAX_CONDITIONS = 24
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
+# CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
+# starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
+# alternate, so that the controller's rhythm features pass the synchronous corner: the four
+# seeds of 1016-1099 whose extensors overlap by more than 0.4 (<e_L e_R> / sqrt(<e_L^2>
+# <e_R^2>) over 0.5-3 s; the settled walk's is 0) in scripts/scan_transients.py. Of the tests'
+# CPG seeds, 15 starts that way (0.58) and 10 and 16 partly (0.23, 0.16); of the sixteen
+# first tuning conditions' open-loop Table 2 walks none does (at most 0.22): a corner tuned
+# without them is paid for nothing it does to the walk's start-up.
+TRANSIENT_SEEDS = (1030, 1037, 1038, 1075)
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -111,6 +120,21 @@ FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests
 # the tests' two walk networks (tests/test_physics.py: periods 9.57 and 16.63), so a
 # controller tuned with them is checked on networks it never saw.
 TUNING_WALKS = ((-0.566, 0.202, 0.772), (-0.039, -0.09, 0.334))
+
+
+def extensor_overlap(gait: str, seed: int, t0_s: float = 0.5, t1_s: float = 3.0) -> float:
+    """How much the extensor cells of ``gait``'s Morris-Lecar preset, started from CPG seed
+    ``seed``'s random state, burst together between t0_s and t1_s of the rollout's clock:
+    <e_L e_R> / sqrt(<e_L^2> <e_R^2>) of their activations (1 in phase, 0 never together; the
+    selection rule of :data:`TRANSIENT_SEEDS`)."""
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.control.controller import cpg_schedule
+
+    s = cpg_schedule(build("ml", gait, seed=seed), t1_s)
+    t = np.arange(len(s.a)) * s.dt_s
+    e = s.a[(t >= t0_s) & (t < t1_s)][:, 2:4]
+    return float((e[:, 0] * e[:, 1]).mean() / np.sqrt((e[:, 0] ** 2).mean()
+                                                      * (e[:, 1] ** 2).mean()))
 
 
 def tuning_conditions(n: int) -> list[dict]:
@@ -123,7 +147,9 @@ def tuning_conditions(n: int) -> list[dict]:
     From the seventeenth on, every gait is driven by the Hopf network's preset (``network``:
     "hopf"), whose bursts have another shape (a walk's extensors burst for about 43% of the
     cycle, the Morris-Lecar walk's for 30%), so that the gains serve a rhythm rather than one
-    network's waveform."""
+    network's waveform. The twenty-first to twenty-fourth start from :data:`TRANSIENT_SEEDS`
+    (the walk network starts in a jump's rhythm); pick them with
+    :attr:`TuneSettings.condition_ids` (``--conditions 1-8,21-24``)."""
     from cpgbiped.cpg.feedback import RECOMMENDED
 
     if not 1 <= int(n) <= MAX_CONDITIONS:
@@ -141,8 +167,30 @@ def tuning_conditions(n: int) -> list[dict]:
     variants += [{"network": "hopf"}, {"network": "hopf", "friction_scale": 0.8},
                  {"network": "hopf", "push": (5.5, 4.0)},
                  {"network": "hopf", "friction_scale": 1.25}]
-    return [{"cpg_seed": FIRST_TUNING_SEED + k,
-             **(extra[k] if k < len(extra) else variants[k - len(extra)])} for k in range(int(n))]
+    out = [{"cpg_seed": FIRST_TUNING_SEED + k,
+            **(extra[k] if k < len(extra) else variants[k - len(extra)])}
+           for k in range(min(int(n), 20))]
+    return out + [{"cpg_seed": s} for s in TRANSIENT_SEEDS[:max(0, int(n) - 20)]]
+
+
+def condition_ids(text: str) -> tuple[int, ...]:
+    """The 1-based numbers of tuning conditions in ``1-8,21-24`` (numbers and ranges), in order,
+    without repeats (``--conditions`` takes this or a plain N, the first N)."""
+    ids = []
+    for part in str(text).split(","):
+        part = part.strip()
+        try:
+            if "-" in part:
+                a, b = (int(x) for x in part.split("-", 1))
+                ids += range(a, b + 1) if a <= b else [0]
+            else:
+                ids.append(int(part))
+        except ValueError:
+            raise InputError(f"tuning conditions must be N or numbers and ranges such as "
+                             f"1-8,21-24, got {text!r}") from None
+    if not ids or any(not 1 <= k <= MAX_CONDITIONS for k in ids):
+        raise InputError(f"tuning conditions are numbered 1-{MAX_CONDITIONS}, got {text!r}")
+    return tuple(dict.fromkeys(ids))
 
 
 def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
@@ -175,13 +223,24 @@ class TuneSettings:
     n_conditions: int = 6
     sigma: float = 0.15  # CMA-ES: initial step, in units of each variable's range
     only: tuple[str, ...] = ()  # search only these gains (names of gains; empty: all)
+    condition_ids: tuple[int, ...] = ()  # 1-based tuning conditions (empty: the first n_conditions)
+
+    def conditions(self) -> list[dict]:
+        """The tuning conditions every candidate is scored under."""
+        if not self.condition_ids:
+            return tuning_conditions(self.n_conditions)
+        every = tuning_conditions(MAX_CONDITIONS)
+        return [every[k - 1] for k in self.condition_ids]
 
     def __post_init__(self):
-        known = set(CORNER_RANGES) | set(SHARED_RANGES)
+        known = (set(CORNER_RANGES) | set(SHARED_RANGES)
+                 | {f"{c}.{g}" for c in kernel.CORNERS for g in (*CORNER_RANGES, "*")})
         bad = [n for n in self.only if n not in known]
         if bad:
             raise InputError(f"unknown gain {', '.join(map(repr, bad))} in --only: use names "
-                             f"of {', '.join(sorted(known))}")
+                             f"of {', '.join(sorted(set(CORNER_RANGES) | set(SHARED_RANGES)))}, "
+                             f"or <corner>.<gain> or <corner>.* with a corner of "
+                             f"{', '.join(kernel.CORNERS)}")
         check_gaits(",".join(self.gaits))
         if self.search not in SEARCHES:
             raise InputError(f"unknown search {self.search!r}: use {', '.join(SEARCHES)}")
@@ -189,12 +248,15 @@ class TuneSettings:
             raise InputError(f"unknown algorithm {self.algorithm!r}: use {', '.join(ALGORITHMS)}")
         if not (np.isfinite(self.seconds) and 2.0 <= self.seconds <= 60.0):
             raise InputError(f"seconds per rollout must be in [2, 60], got {self.seconds}")
-        for k, cond in enumerate(tuning_conditions(self.n_conditions)):
+        if any(not 1 <= k <= MAX_CONDITIONS for k in self.condition_ids):
+            raise InputError(f"tuning conditions are numbered 1-{MAX_CONDITIONS}")
+        for k, cond in zip(self.condition_ids or range(1, self.n_conditions + 1),
+                           self.conditions()):
             if "push" in cond and cond["push"][0] >= SETTLE_S + self.seconds:
                 raise InputError(
-                    f"tuning condition {k + 1} pushes at {cond['push'][0]:g} s, after the end of "
+                    f"tuning condition {k} pushes at {cond['push'][0]:g} s, after the end of "
                     f"a {SETTLE_S + self.seconds:g} s rollout: use --seconds above "
-                    f"{cond['push'][0] - SETTLE_S:g} or --conditions {k} or fewer")
+                    f"{cond['push'][0] - SETTLE_S:g} or leave condition {k} out")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
         if self.only and not variables(self):
@@ -214,8 +276,10 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
             out += [(f"{CORNER_OF[g]}.{k}", lo, hi) for k, (lo, hi) in CORNER_RANGES.items()]
     if settings.search in ("shared", "both"):
         out += [(k, lo, hi) for k, (lo, hi) in SHARED_RANGES.items()]
-    if settings.only:
-        out = [v for v in out if v[0].split(".")[-1] in settings.only]
+    if settings.only:  # a gain at every searched corner, "<corner>.<gain>" or "<corner>.*"
+        out = [v for v in out if v[0].split(".")[-1] in settings.only or v[0] in settings.only
+               or (f"{v[0].split('.')[0]}.*" in settings.only
+                   and v[0].split(".")[-1] not in OPT_IN)]
     else:
         out = [v for v in out if v[0].split(".")[-1] not in OPT_IN]
     return out
@@ -283,7 +347,7 @@ class ControllerTuningProblem(Problem):
         self.gait = settings.gait
         self.base = base
         self.names = [n for n, _, _ in variables(settings)]
-        self.conditions = tuning_conditions(settings.n_conditions)
+        self.conditions = settings.conditions()
         self.runner = runner
         self.history: list[tuple[int, float, float]] = []  # generation, best, median score
         lo = np.array([v[1] for v in variables(settings)])
@@ -323,6 +387,14 @@ class ControllerTuningProblem(Problem):
         out["F"] = self.objectives(costs)
         score = costs.mean(axis=1) + 0.5 * costs.max(axis=1)
         self.history.append((len(self.history) + 1, float(score.min()), float(np.median(score))))
+
+    def resume_key(self) -> dict:
+        """Beside the settings, what a checkpoint must share with this run to resume it: the
+        conditions themselves (their seeds, not only their numbers) and the starting gains."""
+        import json
+
+        return {"conditions": json.loads(json.dumps(self.conditions)),
+                "start_sha256": params_sha256(self.base)}
 
     def restore(self, saved: "ControllerTuningProblem") -> None:
         """Take over the history of the problem a checkpoint saved (resuming a run)."""
