@@ -872,3 +872,32 @@ def test_an_interrupt_that_a_library_turns_into_its_own_error_is_still_one_line(
     monkeypatch.setattr(cli, "cmd_matsuoka", lambda a: 1 / 0)  # no signal: an internal error
     assert cli.main(["matsuoka"]) == 1
     assert "internal error: ZeroDivisionError" in capsys.readouterr().err
+
+
+def test_a_second_ctrl_c_after_the_first_was_handled_cannot_kill_the_process(monkeypatch,
+                                                                             capsys):
+    """The console entry point leaves main() with SIGINT and SIGTERM ignored, never with the
+    default handlers in between: a second Ctrl-C arriving after the first was handled (the
+    line printed, the outputs settled) would otherwise end the interpreter by the signal
+    (exit -2) instead of 130. Called from Python, main() gives the caller's handlers back."""
+    from cpgbiped.envs.cli import main as cli
+
+    def interrupted(a):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(5)
+
+    monkeypatch.setattr(cli, "cmd_matsuoka", interrupted)
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert cli.main(["matsuoka"]) == 130
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # given back
+        assert cli.main(["matsuoka"], ignore_signals_after=True) == 130
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_IGN
+        os.kill(os.getpid(), signal.SIGINT)  # ignored: nothing is raised
+        time.sleep(0.05)
+    finally:
+        for s, h in before.items():
+            signal.signal(s, h)
+    assert capsys.readouterr().err.strip().splitlines() == ["cpgbiped: interrupted"] * 2

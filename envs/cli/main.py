@@ -1278,10 +1278,13 @@ def _on_sigint(signum, frame):
     raise KeyboardInterrupt()
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, ignore_signals_after: bool = False) -> int:
     """Run the command line; every failure is one line on stderr: exit 2 for bad input, 1 for
     anything unexpected ("internal error"; the traceback only with --debug), 130 on Ctrl-C,
-    143 on SIGTERM (handled like Ctrl-C)."""
+    143 on SIGTERM (handled like Ctrl-C). The signal handlers it installs are restored on the
+    way out, or, with ``ignore_signals_after`` (the console entry point, whose process ends
+    next), replaced by SIG_IGN without a moment of the default handlers in between: a second
+    Ctrl-C right after the first was handled would otherwise kill the interpreter (exit -2)."""
     import threading
 
     previous = {}
@@ -1294,7 +1297,9 @@ def main(argv: list[str] | None = None) -> int:
         return _main(argv)
     finally:
         for sig, handler in previous.items():
-            if handler is not None:
+            if ignore_signals_after:
+                signal.signal(sig, signal.SIG_IGN)
+            elif handler is not None:
                 signal.signal(sig, handler)
 
 
@@ -1346,7 +1351,7 @@ def run() -> int:
     traceback and exit -2)."""
     import signal
 
-    code = main()
+    code = main(ignore_signals_after=True)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     return code
