@@ -7,8 +7,9 @@
 # the trunk nearer upright (pitch target 0.1 rad, was 0.24). Then a CMA-ES stage of the jump's
 # corner scored on the jump alone (8 conditions), and one of the same corner scored on the walk
 # and the jump (conditions 1-8 and 21-24, whose CPG states start the walk network in a jump's
-# rhythm); then two stages of the walk's corner (w5, w6). About 45 minutes on 2 cores. Results: OUT/<stage>/ (default
-# out/jump_experiment); drive the body with one as scripts/tune_run_experiment.sh says.
+# rhythm); then two stages of the walk's corner (w5, w6). About 45 minutes on 2 cores.
+# Results: OUT/<stage>/ (default out/jump_experiment); drive the body with one as
+# scripts/tune_run_experiment.sh says.
 # Usage: bash scripts/tune_jump_experiment.sh [OUT]
 set -euo pipefail
 cd "$(dirname "$0")/.."

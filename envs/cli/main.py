@@ -1346,15 +1346,10 @@ def _main(argv: list[str] | None) -> int:
 
 
 def run() -> int:
-    """The console entry point: :func:`main`, then Ctrl-C ignored while the interpreter shuts
-    down (the run is over and its outputs are in place: an interrupt then would only print a
-    traceback and exit -2)."""
-    import signal
-
-    code = main(ignore_signals_after=True)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    return code
+    """The console entry point: :func:`main`, which leaves Ctrl-C and SIGTERM ignored while
+    the interpreter shuts down (the run is over and its outputs are in place: an interrupt
+    then would only print a traceback and exit -2)."""
+    return main(ignore_signals_after=True)
 
 
 if __name__ == "__main__":
