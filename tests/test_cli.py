@@ -46,6 +46,8 @@ def test_help_reads_like_a_manual():
     (["tune", "--gait", "walk", "--conditions", "1-8,25"], "numbered 1-24"),
     (["tune", "--gait", "walk", "--conditions", "8-1"], "numbered 1-24"),
     (["tune", "--gait", "walk", "--only", "synchronous.push"], "names no gain"),
+    (["tune", "--gait", "jump", "--guard", "walk"], "must be scored too"),
+    (["tune", "--gait", "walk", "--guard", "walk", "--guard-gains", "nope.json"], "nope.json"),
 ])
 def test_bad_input_one_line_nonzero(args, msg):
     r = run(*args)

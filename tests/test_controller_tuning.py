@@ -321,3 +321,52 @@ def test_gains_set_by_hand_are_a_link_of_the_chain(tmp_path):
     assert prov[-1]["result_sha256"] == params_sha256(p) != params_sha256(CONTROL)
     with pytest.raises(InputError, match="unknown gain"):
         set_by_hand(GAINS_FILE, {"alternating.no_such_gain": 1.0}, out, "bad")
+
+
+def test_guard_counts_only_a_guarded_gaits_excess_over_its_reference():
+    """--guard walk: in each condition, the walk's cost above its cost under the guard's gains
+    by more than GUARD_TOL counts GUARD times; below the tolerance, or for a gait not guarded,
+    nothing is added."""
+    from cpgbiped.envs.search.controller_tuning import GUARD, GUARD_TOL, ControllerTuningProblem
+
+    s = TuneSettings(("walk", "jump"), only=("synchronous.*",), guard=("walk",))
+    prob = ControllerTuningProblem(s, CONTROL)
+    prob.guard_costs = np.array([[0.2, 5.0], [1.0, 8.0], [3.0, 1.0]])  # (condition, gait)
+    gc = np.array([[0.2 + 0.5 * GUARD_TOL, 1.0],  # within the tolerance; the jump got better
+                   [2.0, 20.0],  # the walk 1.0 above: 0.9 beyond the tolerance
+                   [1.0, 9.0]])  # the walk better: no credit; the jump worse: not guarded
+    assert np.allclose(prob.guard_penalty(gc), [0.0, GUARD * (1.0 - GUARD_TOL), 0.0])
+    # without a guard nothing is added
+    free = ControllerTuningProblem(TuneSettings(("walk", "jump"), only=("synchronous.*",)), CONTROL)
+    assert np.allclose(free.guard_penalty(gc), 0.0)
+
+
+def test_guard_compares_with_the_guard_gains_not_the_start():
+    """The guard's reference costs are those of --guard-gains' gains (here the hand-set root,
+    not the start), rolled out under the same conditions."""
+    from cpgbiped.envs.control.controller import params_array
+    from cpgbiped.envs.search.controller_tuning import ControllerTuningProblem
+
+    seen = []
+
+    def runner(trials):
+        seen.extend(trials)
+        return [walk_summary() for _ in trials]
+
+    s = TuneSettings(("walk", "jump"), only=("synchronous.*",), n_conditions=2,
+                     guard=("walk",), guard_gains=str(ROOT_GAINS_FILE))
+    prob = ControllerTuningProblem(s, CONTROL, runner)
+    ref = prob.reference_costs()
+    root = tuple(params_array(read_gains(ROOT_GAINS_FILE)[0]).tolist())
+    assert ref.shape == (2, 2) and len(seen) == 4
+    assert all(t.control == root for t in seen)
+    assert root != tuple(params_array(CONTROL).tolist())
+
+
+def test_guard_settings_refuse_bad_input():
+    with pytest.raises(InputError, match="must be scored too"):
+        TuneSettings(("jump",), guard=("walk",))
+    with pytest.raises(InputError, match="needs --guard"):
+        TuneSettings(("jump",), guard_gains="x.json")
+    with pytest.raises(InputError, match="unknown gait"):
+        TuneSettings(("walk",), guard=("skip",))

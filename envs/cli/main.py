@@ -411,13 +411,16 @@ def cmd_tune(a) -> int:
     out_dir(a.out)
     check_workers(a)
     n_cond, ids = a.conditions
+    guard = check_gaits(a.guard) if a.guard else ()
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
-                            n_cond, a.sigma, only_arg(a.only), ids)
+                            n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "")
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
 
     read_gains(start)  # a bad starting file is refused before any work
+    if a.guard_gains:
+        read_gains(a.guard_gains)
     args = (settings.seconds, 2.0)
     if a.dask is not None:
         runner = DaskRunner(*args, address=None if a.dask == "local" else a.dask)
@@ -1215,6 +1218,13 @@ def build_parser() -> argparse.ArgumentParser:
                          "scored on both gaits; land_yield is searched only when named here")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
                     help="gains file to start from (default: the controller's, envs/control/gains.json)")
+    sp.add_argument("--guard", default="", metavar="GAITS",
+                    help="gaits (also named in --gait) that may not get worse: in every "
+                         "condition a guarded gait's cost above its cost under --guard-gains "
+                         "(plus 0.1) counts 10 times, so that a search of one gait's corner "
+                         "cannot buy it with another gait's quality")
+    sp.add_argument("--guard-gains", default=None, metavar="GAINS.json",
+                    help="the gains the guard compares with (default: --start)")
     sp.add_argument("--workers", type=count_arg(1), default=None,
                     help="rollout processes (default: one per core)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",

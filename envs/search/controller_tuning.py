@@ -40,6 +40,11 @@ far before it falls ranks above one that stands still, so a search that starts f
 standing is led towards walking instead of towards not moving.
 A candidate's cost sums its gaits' costs per condition; over the conditions, CMA-ES minimises
 mean + 0.5 max (the worst condition counts), NSGA-II the pair (mean, max).
+The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
+there under the guard's gains (``--guard-gains``, default the start) by more than GUARD_TOL;
+each unit beyond adds GUARD to that condition. A search of the jump's corner scored on the
+walk as well once traded the walk's start-up for the jump (the sum let it); the guard makes
+the walk a constraint rather than one term of a sum.
 
 Algorithms: CMA-ES (:class:`cpg.cmaes.CMAES`, checkpointable, started from the gains file's
 values) and NSGA-II (pymoo, its first population the gains file's values plus points around
@@ -96,6 +101,10 @@ if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHAR
 TARGET_FROUDE = {"walk": 0.11, "run": 0.33}  # progress target (criteria: Fr >= 0.08, 0.25)
 SURVIVAL, PROGRESS, FALL, SHORTFALL, MARGIN = 10.0, 10.0, 5.0, 3.0, 0.03
 POSTURE, LEAN_FREE_DEG = 1.0, 10.0  # per 10 deg of mean trunk lean beyond 10 deg
+# The guard (--guard): a guarded gait's cost in a condition may exceed its cost under the
+# guard's gains by GUARD_TOL (the rollouts are deterministic, but a body this chaotic moves
+# its cost by a few hundredths for any change); each unit beyond counts GUARD times.
+GUARD, GUARD_TOL = 10.0, 0.1
 ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
@@ -224,6 +233,8 @@ class TuneSettings:
     sigma: float = 0.15  # CMA-ES: initial step, in units of each variable's range
     only: tuple[str, ...] = ()  # search only these gains (names of gains; empty: all)
     condition_ids: tuple[int, ...] = ()  # 1-based tuning conditions (empty: the first n_conditions)
+    guard: tuple[str, ...] = ()  # gaits that may not get worse than under guard_gains
+    guard_gains: str = ""  # the gains file the guard compares with (empty: the start's)
 
     def conditions(self) -> list[dict]:
         """The tuning conditions every candidate is scored under."""
@@ -242,6 +253,14 @@ class TuneSettings:
                              f"or <corner>.<gain> or <corner>.* with a corner of "
                              f"{', '.join(kernel.CORNERS)}")
         check_gaits(",".join(self.gaits))
+        if self.guard:
+            check_gaits(",".join(self.guard))
+            missing = [g for g in self.guard if g not in self.gaits]
+            if missing:
+                raise InputError(f"--guard {','.join(missing)}: a guarded gait must be scored "
+                                 f"too; add it to --gait")
+        elif self.guard_gains:
+            raise InputError("--guard-gains needs --guard (the gaits it guards)")
         if self.search not in SEARCHES:
             raise InputError(f"unknown search {self.search!r}: use {', '.join(SEARCHES)}")
         if self.algorithm not in ALGORITHMS:
@@ -350,6 +369,7 @@ class ControllerTuningProblem(Problem):
         self.conditions = settings.conditions()
         self.runner = runner
         self.history: list[tuple[int, float, float]] = []  # generation, best, median score
+        self.guard_costs = None  # (n_conditions, n_gaits): the guarded gaits' reference costs
         lo = np.array([v[1] for v in variables(settings)])
         hi = np.array([v[2] for v in variables(settings)])
         n_obj = 1 if settings.algorithm == "cmaes" else 2
@@ -359,9 +379,39 @@ class ControllerTuningProblem(Problem):
         P = tuple(params_array(with_values(self.base, self.names, x)).tolist())
         return [condition_trial(g, P, c) for c in self.conditions for g in self.settings.gaits]
 
+    def gait_costs(self, results: list) -> np.ndarray:
+        """(n_conditions, n_gaits) rollout costs of one point's results (condition-major)."""
+        n_g, n_c = len(self.settings.gaits), len(self.conditions)
+        return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds)
+                          for j, g in enumerate(self.settings.gaits)] for c in range(n_c)])
+
+    def reference_costs(self) -> np.ndarray:
+        """The guarded gaits' costs under the guard's gains (:attr:`TuneSettings.guard_gains`,
+        else the start's), per condition and gait; zero for gaits not guarded."""
+        if self.guard_costs is None:
+            ref = (read_gains(self.settings.guard_gains)[0] if self.settings.guard_gains
+                   else self.base)
+            P = tuple(params_array(ref).tolist())
+            trials = [condition_trial(g, P, c) for c in self.conditions
+                      for g in self.settings.gaits]
+            self.guard_costs = self.gait_costs(self.runner(trials))
+        return self.guard_costs
+
+    def guard_penalty(self, gait_costs: np.ndarray) -> np.ndarray:
+        """Per condition: GUARD x the guarded gaits' excess over their reference cost beyond
+        GUARD_TOL (0 without --guard)."""
+        if not self.settings.guard:
+            return np.zeros(len(gait_costs))
+        mask = np.array([g in self.settings.guard for g in self.settings.gaits], float)
+        excess = np.maximum(0.0, gait_costs - self.reference_costs() - GUARD_TOL)
+        return GUARD * (excess * mask).sum(axis=1)
+
     def evaluate_points(self, X) -> tuple[np.ndarray, list]:
-        """(costs (P, n_conditions), summaries per point) of parameter vectors X."""
+        """(costs (P, n_conditions), summaries per point) of parameter vectors X: the named
+        gaits' rollout costs summed per condition, plus the guard's penalty."""
         X = np.atleast_2d(np.asarray(X, float))
+        if self.settings.guard:
+            self.reference_costs()
         trials = [t for x in X for t in self.trials(x)]
         results = self.runner(trials)
         n_g, n_c = len(self.settings.gaits), len(self.conditions)
@@ -371,9 +421,8 @@ class ControllerTuningProblem(Problem):
         for k in range(len(X)):
             r = results[k * per:(k + 1) * per]
             groups.append(r)
-            for c in range(n_c):
-                costs[k, c] = sum(rollout_cost(g, r[c * n_g + j], self.settings.seconds)
-                                  for j, g in enumerate(self.settings.gaits))
+            gc = self.gait_costs(r)
+            costs[k] = gc.sum(axis=1) + self.guard_penalty(gc)
         return costs, groups
 
     def objectives(self, costs: np.ndarray) -> np.ndarray:
@@ -393,12 +442,16 @@ class ControllerTuningProblem(Problem):
         conditions themselves (their seeds, not only their numbers) and the starting gains."""
         import json
 
-        return {"conditions": json.loads(json.dumps(self.conditions)),
-                "start_sha256": params_sha256(self.base)}
+        key = {"conditions": json.loads(json.dumps(self.conditions)),
+               "start_sha256": params_sha256(self.base)}
+        if self.settings.guard_gains:
+            key["guard_sha256"] = params_sha256(read_gains(self.settings.guard_gains)[0])
+        return key
 
     def restore(self, saved: "ControllerTuningProblem") -> None:
         """Take over the history of the problem a checkpoint saved (resuming a run)."""
         self.history = list(saved.history)
+        self.guard_costs = getattr(saved, "guard_costs", None)
 
     def __getstate__(self):  # checkpoints never hold worker processes or a cluster
         state = self.__dict__.copy()
@@ -490,6 +543,11 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
         "kept_start": bool(k == len(P) - 1),
         "started_from": str(start), "started_from_sha256": params_sha256(base),
         "result_sha256": params_sha256(tuned),
+        **({"guard": list(settings.guard), "guard_gains": settings.guard_gains or str(start),
+            "guard_sha256": params_sha256(read_gains(settings.guard_gains)[0]
+                                          if settings.guard_gains else base),
+            "guard_reference_costs": np.round(problem.reference_costs(), 4).tolist()}
+           if settings.guard else {}),
         "wall_s": round(time.perf_counter() - t0, 1),
     }
     gains = {"format": GAINS_FORMAT, **params_to_dict(tuned),
