@@ -192,3 +192,61 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
         assert len(flex) >= 8, (y, len(flex))
         give[y] = float(np.mean(flex))
     assert give[0.0] < 0.02 and give[1.0] > 0.03, give
+
+
+def _first_controls(params, a, t_s):
+    """The controls of a fresh controller's first call at t_s (s) on the lifted body: the
+    features are still their prior, so only the gains differ between parameter sets."""
+    m, d = lifted_body()
+    return CPGController(m, d, synthetic(a), params=params)(t_s).copy()
+
+
+def test_startup_gains_hand_over_to_the_corners():
+    """Start-up gains blend as the corners do and hand over to them as exp(-t / tau_s): at the
+    body's start the controls are those of the start-up corners alone, 30 tau_s later those of
+    the corners alone (to 1e-9); the two sets give other controls, so the test can fail."""
+    from dataclasses import replace
+
+    from cpgbiped.envs.control.controller import read_gains
+    from cpgbiped.envs.search.controller_tuning import ROOT_GAINS_FILE
+
+    root = read_gains(ROOT_GAINS_FILE)[0]
+    tau = 0.5
+    both = replace(CONTROL, startup=tuple(root.corner(c) for c in K.CORNERS), startup_tau_s=tau)
+    start_alone = replace(CONTROL, startup=None,
+                          **{c: root.corner(c) for c in K.CORNERS})
+    live_alone = replace(CONTROL, startup=None)
+    t = np.arange(0.0, 20.0, DT)
+    a = np.stack([square(t, 1.07, lag, 0.3) for lag in (0.5, 0.0, 0.0, 0.5)], axis=1)
+    assert np.allclose(_first_controls(both, a, 0.0), _first_controls(start_alone, a, 0.0),
+                       atol=1e-9, rtol=0)
+    assert np.allclose(_first_controls(both, a, 30 * tau), _first_controls(live_alone, a, 30 * tau),
+                       atol=1e-9, rtol=0)
+    assert not np.allclose(_first_controls(start_alone, a, 0.0), _first_controls(live_alone, a, 0.0),
+                           atol=1e-3)
+
+
+def test_startup_gains_round_trip_and_refuse_bad_input():
+    """A gains file's start-up section reads back as it was written, through the kernel's
+    parameter array too; a hand-over time outside (0, 60] s, or a start-up section without
+    every corner, is refused with a clear error."""
+    from dataclasses import replace
+
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.envs.control.controller import (params_array, params_from_array,
+                                                  params_from_dict, params_to_dict)
+
+    p = replace(CONTROL, startup=tuple(CONTROL.corner(c) for c in K.CORNERS), startup_tau_s=2.0)
+    assert params_from_dict(params_to_dict(p)) == p
+    assert params_array(p).shape == (K.P_SIZE_STARTUP,)
+    assert params_from_array(params_array(p)) == p
+    if CONTROL.startup is None:
+        assert params_array(CONTROL).shape == (K.P_SIZE,)
+    d = params_to_dict(p)
+    for tau in (0.0, -1.0, 61.0, float("nan")):
+        bad = {**d, "startup": {**d["startup"], "tau_s": tau}}
+        with pytest.raises(InputError):
+            params_from_dict(bad)
+    bad = {**d, "startup": {"tau_s": 1.0, "corners": {"alternating": d["corners"]["alternating"]}}}
+    with pytest.raises(InputError, match="not a complete set"):
+        params_from_dict(bad)

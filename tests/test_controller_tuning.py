@@ -370,3 +370,25 @@ def test_guard_settings_refuse_bad_input():
         TuneSettings(("jump",), guard_gains="x.json")
     with pytest.raises(InputError, match="unknown gait"):
         TuneSettings(("walk",), guard=("skip",))
+
+
+def test_startup_gains_are_a_link_of_the_chain(tmp_path):
+    """set_startup adds the start-up corners of another gains file, changing nothing else, and
+    records it as a link: what, why, the SHA-256 of the values it started from, of the
+    start-up corners' source and of what it wrote."""
+    from dataclasses import replace
+
+    from cpgbiped.envs.search.controller_tuning import params_sha256, set_startup
+
+    out = tmp_path / "g.json"
+    set_startup(GAINS_FILE, ROOT_GAINS_FILE, 1.5, out, "a test")
+    p, prov = read_gains(out)
+    root, _ = read_gains(ROOT_GAINS_FILE)
+    base = replace(CONTROL, startup=None, startup_tau_s=0.0)
+    assert replace(p, startup=None, startup_tau_s=0.0) == base
+    assert p.startup == tuple(root.corner(c) for c in CORNER_OF.values()) and p.startup_tau_s == 1.5
+    e = prov[-1]
+    assert e["hand_set"] and e["note"] == "a test" and e["command"].startswith("set by hand")
+    assert e["started_from_sha256"] == params_sha256(CONTROL)
+    assert e["startup_from_sha256"] == params_sha256(root)
+    assert e["result_sha256"] == params_sha256(p) != params_sha256(CONTROL)

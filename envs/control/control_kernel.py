@@ -37,6 +37,9 @@ ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0}
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
+# With start-up gains: then the start-up corners in the same layout, then their hand-over
+# time constant tau_s (envs.control.controller.ControlParams.startup).
+P_SIZE_STARTUP = P_SIZE + 4 * len(BLENDED) + 1
 
 # ix layout: MjData addresses.
 (IX_ROOTY_Q, IX_ROOTY_V, IX_HIP_Q, IX_HIP_V, IX_KNEE_Q, IX_KNEE_V, IX_FORCE, IX_COM, IX_COMVEL,
@@ -159,6 +162,14 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     for n in range(len(BLENDED)):
         q = N_SHARED + 4 * n
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
+    # Start-up gains (when P carries them): the same blend of a second set of corners, which
+    # hands over to the first as exp(-t_s / tau_s) (tau_s the last number of P).
+    if P.shape[0] == P_SIZE_STARTUP:
+        nu = math.exp(-t_s / P[P_SIZE_STARTUP - 1])
+        for n in range(len(BLENDED)):
+            q = P_SIZE + 4 * n
+            G[n] = (1.0 - nu) * G[n] + nu * (w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2]
+                                             + w11 * P[q + 3])
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
      swing_rest, x_clear, push_off, knee_hold, land_yield) = (

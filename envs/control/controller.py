@@ -83,6 +83,15 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        (the swing drive tucks the leg while its foot is behind x_clear ahead of the hip - the
        clearance; past that, or without the drive, the leg extends to land).
 
+Start-up gains (optional; the gains file's "startup" section): four more corners, blended by
+the same features, that hand over to the corners above from the moment the body starts,
+    G = (1 - nu) G_corners(sigma, kappa) + nu G_startup(sigma, kappa),  nu = exp(-t / tau_s).
+While the features are still near their neutral prior (a quarter of each corner) and the
+CPG's first cycles pass other corners, the body runs on gains that a later search of one
+corner does not move: without them, a search of the jump's corner changed every walk's first
+steps (README, "Start-up gains"). They change no rhythm: which corner's gains apply is still
+the CPG's features' choice.
+
 What makes the gaits differ is the CPG: left-right extensors in antiphase give alternating
 support (walk, run), in phase both legs push and fly together (jump, hop); synchrony (sigma)
 and flexor-extensor co-activation (kappa) set the leg's stiffness, push, posture and balance
@@ -155,6 +164,10 @@ class ControlParams:
     alternating_coactive: Corner  # sigma = 0, kappa = 1 (the run's)
     synchronous: Corner  # sigma = 1, kappa = 0 (the two-legged jump's)
     synchronous_coactive: Corner  # sigma = 1, kappa = 1 (the two-legged hop's)
+    # Start-up gains (optional): four corners in CORNERS order, blended as the others, that
+    # hand over to them as exp(-t / startup_tau_s) from the moment the body starts.
+    startup: tuple[Corner, Corner, Corner, Corner] | None = None
+    startup_tau_s: float = 0.0
 
     def corner(self, name: str) -> Corner:
         return getattr(self, name)
@@ -165,41 +178,67 @@ class ControlParams:
 
 if tuple(f.name for f in fields(Corner)) != kernel.BLENDED or tuple(
         f.name for f in fields(ControlParams))[:kernel.N_SHARED] != kernel.SHARED or tuple(
-        f.name for f in fields(ControlParams))[kernel.N_SHARED:] != kernel.CORNERS:
+        f.name for f in fields(ControlParams))[kernel.N_SHARED:-2] != kernel.CORNERS:
     raise ImportError("ControlParams and envs.control_kernel's parameter layout disagree")
 
 # The gains file: the controller's parameters and, for each part, the tuning run that made it.
 GAINS_FILE = Path(__file__).with_name("gains.json")
 GAINS_FORMAT = "cpgbiped.gains/1"
+MAX_STARTUP_TAU_S = 60.0  # s: the start-up gains hand over within a rollout's first minute
 
 
 def params_to_dict(p: ControlParams) -> dict:
-    """{"shared": {name: value}, "corners": {corner: {gain: value}}} (plain floats)."""
-    return {"shared": {n: float(getattr(p, n)) for n in kernel.SHARED},
-            "corners": {c: {g: float(getattr(p.corner(c), g)) for g in kernel.BLENDED}
-                        for c in kernel.CORNERS}}
+    """{"shared": {name: value}, "corners": {corner: {gain: value}}} (plain floats), and
+    "startup": {"tau_s": value, "corners": {...}} when there are start-up gains."""
+    d = {"shared": {n: float(getattr(p, n)) for n in kernel.SHARED},
+         "corners": {c: {g: float(getattr(p.corner(c), g)) for g in kernel.BLENDED}
+                     for c in kernel.CORNERS}}
+    if p.startup is not None:
+        d["startup"] = {"tau_s": float(p.startup_tau_s),
+                        "corners": {c: {g: float(getattr(corner, g)) for g in kernel.BLENDED}
+                                    for c, corner in zip(kernel.CORNERS, p.startup)}}
+    return d
 
 
 def params_from_dict(d: dict, what: str = "gains") -> ControlParams:
     """The inverse of :func:`params_to_dict`; every name must be there, finite, and known."""
-    try:
-        shared, corners = d["shared"], d["corners"]
+    def complete(corners):
         # a file written before a gain was added reads as that gain's neutral value
         corners = {c: {**kernel.ADDED_NEUTRAL, **v} if isinstance(v, dict) else v
                    for c, v in corners.items()}
-        if set(shared) != set(kernel.SHARED) or set(corners) != set(kernel.CORNERS) or any(
+        if set(corners) != set(kernel.CORNERS) or any(
                 set(corners[c]) != set(kernel.BLENDED) for c in kernel.CORNERS):
+            raise KeyError("names")
+        return corners
+
+    try:
+        shared, corners = d["shared"], complete(d["corners"])
+        if set(shared) != set(kernel.SHARED):
             raise KeyError("names")
         vals = [float(shared[n]) for n in kernel.SHARED] + [
             float(corners[c][g]) for c in kernel.CORNERS for g in kernel.BLENDED]
+        startup, tau_s = d.get("startup"), 0.0
+        if startup is not None:
+            tau_s, startup = float(startup["tau_s"]), complete(startup["corners"])
+            vals += [tau_s] + [float(startup[c][g]) for c in kernel.CORNERS
+                               for g in kernel.BLENDED]
     except (KeyError, TypeError, ValueError) as e:
         raise InputError(f"{what}: not a complete set of the controller's parameters "
                          f"({type(e).__name__}: {e})") from None
     if not np.all(np.isfinite(vals)):
         raise InputError(f"{what}: the controller's parameters must be finite numbers")
+    if startup is not None and not 0.0 < tau_s <= MAX_STARTUP_TAU_S:
+        raise InputError(f"{what}: the start-up gains' hand-over time constant must be in "
+                         f"(0, {MAX_STARTUP_TAU_S:g}] s, got {tau_s:g}")
+
+    def corner_set(c):
+        return tuple(Corner(**{g: float(c[k][g]) for g in kernel.BLENDED})
+                     for k in kernel.CORNERS)
+
     return ControlParams(**{n: float(shared[n]) for n in kernel.SHARED},
-                         **{c: Corner(**{g: float(corners[c][g]) for g in kernel.BLENDED})
-                            for c in kernel.CORNERS})
+                         **dict(zip(kernel.CORNERS, corner_set(corners))),
+                         startup=None if startup is None else corner_set(startup),
+                         startup_tau_s=tau_s)
 
 
 def gains_schema() -> dict:
@@ -213,15 +252,18 @@ def gains_schema() -> dict:
                 "required": [n for n in names if n not in kernel.ADDED_NEUTRAL],
                 "properties": {n: num for n in names}}
 
+    corners = {"type": "object", "required": list(kernel.CORNERS), "additionalProperties": False,
+               "properties": {c: block(kernel.BLENDED) for c in kernel.CORNERS}}
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "type": "object", "required": ["format", "shared", "corners"],
         "properties": {
             "format": {"const": GAINS_FORMAT},
             "shared": block(kernel.SHARED),
-            "corners": {"type": "object", "required": list(kernel.CORNERS),
+            "corners": corners,
+            "startup": {"type": "object", "required": ["tau_s", "corners"],
                         "additionalProperties": False,
-                        "properties": {c: block(kernel.BLENDED) for c in kernel.CORNERS}},
+                        "properties": {"tau_s": num, "corners": corners}},
             "provenance": {"type": "array", "items": {"type": "object"}, "maxItems": 10_000},
         },
     }
@@ -277,21 +319,32 @@ def params_array(p: ControlParams) -> np.ndarray:
     out = [float(getattr(p, n)) for n in kernel.SHARED]
     for g in kernel.BLENDED:
         out += [float(getattr(p.corner(c), g)) for c in kernel.CORNERS]
+    if p.startup is not None:
+        for g in kernel.BLENDED:
+            out += [float(getattr(corner, g)) for corner in p.startup]
+        out.append(float(p.startup_tau_s))
     return np.array(out)
 
 
 def params_from_array(P: np.ndarray) -> ControlParams:
     """The inverse of :func:`params_array`."""
     P = np.asarray(P, float)
-    if P.shape != (kernel.P_SIZE,):
-        raise InputError(f"a controller parameter array has {kernel.P_SIZE} numbers, "
-                         f"got shape {P.shape}")
-    shared = dict(zip(kernel.SHARED, P[:kernel.N_SHARED].tolist()))
-    corners = {c: {} for c in kernel.CORNERS}
-    for n, g in enumerate(kernel.BLENDED):
-        for k, c in enumerate(kernel.CORNERS):
-            corners[c][g] = float(P[kernel.N_SHARED + 4 * n + k])
-    return params_from_dict({"shared": shared, "corners": corners}, "parameter array")
+    if P.shape not in ((kernel.P_SIZE,), (kernel.P_SIZE_STARTUP,)):
+        raise InputError(f"a controller parameter array has {kernel.P_SIZE} numbers (or "
+                         f"{kernel.P_SIZE_STARTUP} with start-up gains), got shape {P.shape}")
+
+    def corners_at(first):
+        out = {c: {} for c in kernel.CORNERS}
+        for n, g in enumerate(kernel.BLENDED):
+            for k, c in enumerate(kernel.CORNERS):
+                out[c][g] = float(P[first + 4 * n + k])
+        return out
+
+    d = {"shared": dict(zip(kernel.SHARED, P[:kernel.N_SHARED].tolist())),
+         "corners": corners_at(kernel.N_SHARED)}
+    if P.shape == (kernel.P_SIZE_STARTUP,):
+        d["startup"] = {"tau_s": float(P[-1]), "corners": corners_at(kernel.P_SIZE)}
+    return params_from_dict(d, "parameter array")
 
 
 def without_ankle_drive(p: ControlParams) -> ControlParams:

@@ -73,7 +73,7 @@ from cpgbiped.cpg.errors import InputError
 
 from cpgbiped.envs.control import control_kernel as kernel
 from cpgbiped.envs.control.controller import (GAINS_FILE, GAINS_FORMAT, ControlParams, params_array,
-                         params_from_array, params_to_dict, read_gains)
+                         params_from_array, params_from_dict, params_to_dict, read_gains)
 from cpgbiped.envs.gaits.criteria import CRITERIA, SETTLE_S
 from cpgbiped.envs.simulation.trials import ControlTrial
 
@@ -603,6 +603,34 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
     entry = {"part": sorted({n.split(".")[0] for n in names if "." in n}) or ["shared"],
              "hand_set": True, "set": {n: float(values[n]) for n in names}, "note": why,
              "command": f"set by hand ({', '.join(names)})",
+             "started_from": str(start), "started_from_sha256": params_sha256(base),
+             "result_sha256": params_sha256(p)}
+    gains = {"format": GAINS_FORMAT, **params_to_dict(p), "provenance": list(provenance) + [entry]}
+    write_json(out, gains)
+    return gains
+
+
+def set_startup(start: str | Path, startup_from: str | Path, tau_s: float, out: str | Path,
+                why: str) -> dict:
+    """A link of a tuning chain that is not a search: ``start``'s gains with start-up gains,
+    the four corners of ``startup_from``'s gains, handed over to ``start``'s corners as
+    exp(-t / tau_s) (:class:`cpgbiped.envs.control.controller.ControlParams`), written to
+    ``out`` with a provenance entry as :func:`set_by_hand` writes (what was set, why, the
+    SHA-256 of the values it started from, of the start-up corners' source, and of the result)."""
+    from dataclasses import replace
+
+    from cpgbiped.cpg.io import write_json
+
+    base, provenance = read_gains(start)
+    source, _ = read_gains(startup_from)
+    corners = tuple(source.corner(c) for c in kernel.CORNERS)
+    p = params_from_dict(params_to_dict(replace(base, startup=corners, startup_tau_s=float(tau_s))),
+                         "start-up gains")
+    entry = {"part": ["startup"], "hand_set": True,
+             "set": {"startup.tau_s": float(tau_s), "startup.corners": str(startup_from)},
+             "startup_from_sha256": params_sha256(source), "note": why,
+             "command": f"set by hand (start-up gains: the corners of {startup_from}, "
+                        f"tau_s {float(tau_s):g})",
              "started_from": str(start), "started_from_sha256": params_sha256(base),
              "result_sha256": params_sha256(p)}
     gains = {"format": GAINS_FORMAT, **params_to_dict(p), "provenance": list(provenance) + [entry]}

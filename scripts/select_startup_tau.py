@@ -1,0 +1,76 @@
+"""Choose the start-up gains' hand-over time constant tau_s on selection states disjoint from
+the tests' and the README's.
+
+For each candidate tau_s, the gains are --live's corners with --startup-from's corners as
+start-up gains (envs.search.controller_tuning.set_startup). The walk preset is validated from
+the random CPG states of seeds 2000-2099 and the jump preset from 2000-2049 (20 s after
+settling, as ``cpgbiped validate``); seeds 2000-2099 are neither the tuning conditions'
+(1000-1099), the tests' (10-19) nor the census's (3000 and up). The rule, fixed before any
+result was seen: score = walk passes + jump named jump - 3 x (walk falls + jump falls) (a
+fall is worse than a miss); the highest score wins, the smaller tau_s on a tie. Writes
+--out (JSON: the candidates' counts and scores, the choice, this command).
+
+    python scripts/select_startup_tau.py --live out/tune_chain/j2/gains.json \\
+        --startup-from out/tune_chain/w4/gains.json --out envs/control/startup_selection.json
+"""
+import argparse
+import json
+import os
+import sys
+import tempfile
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+CANDIDATES = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
+WALK_SEEDS = range(2000, 2100)
+JUMP_SEEDS = range(2000, 2050)
+
+
+def one(job):
+    gait, seed, gains = job
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.control.controller import read_gains
+    from cpgbiped.envs.gaits.validate import validate
+
+    s = validate(build("ml", gait, seed=seed), gait, 20.0, params=read_gains(gains)[0]).summary()
+    return gait, seed, s["physical_gait"] == gait, not s["failures"], s["fell_at_s"] is not None
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--live", required=True, help="gains whose corners the body runs on")
+    ap.add_argument("--startup-from", required=True, help="gains whose corners start it")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--candidates", default=",".join(map(str, CANDIDATES)))
+    a = ap.parse_args()
+    from cpgbiped.envs.search.controller_tuning import set_startup
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp, ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
+        for tau in (float(x) for x in a.candidates.split(",")):
+            g = str(Path(tmp) / f"gains_{tau:g}.json")
+            set_startup(a.live, a.startup_from, tau, g, "candidate")
+            jobs = [("walk", s, g) for s in WALK_SEEDS] + [("jump", s, g) for s in JUMP_SEEDS]
+            res = list(ex.map(one, jobs))
+            walk = [r for r in res if r[0] == "walk"]
+            jump = [r for r in res if r[0] == "jump"]
+            row = {"tau_s": tau, "walk_passes": sum(r[3] for r in walk),
+                   "walk_falls": sum(r[4] for r in walk), "jump_named": sum(r[2] for r in jump),
+                   "jump_falls": sum(r[4] for r in jump), "n_walk": len(walk), "n_jump": len(jump)}
+            row["score"] = (row["walk_passes"] + row["jump_named"]
+                            - 3 * (row["walk_falls"] + row["jump_falls"]))
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    best = max(rows, key=lambda r: (r["score"], -r["tau_s"]))
+    out = {"rule": "score = walk passes + jump named - 3 (walk falls + jump falls); highest "
+                   "wins, smaller tau_s on a tie",
+           "walk_seeds": [WALK_SEEDS.start, WALK_SEEDS.stop - 1],
+           "jump_seeds": [JUMP_SEEDS.start, JUMP_SEEDS.stop - 1],
+           "command": "python scripts/select_startup_tau.py " + " ".join(sys.argv[1:]),
+           "candidates": rows, "tau_s": best["tau_s"]}
+    Path(a.out).write_text(json.dumps(out, indent=1) + "\n")
+    print(f"select_startup_tau: tau_s = {best['tau_s']:g} (score {best['score']})")
+
+
+if __name__ == "__main__":
+    main()
