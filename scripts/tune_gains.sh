@@ -3,7 +3,7 @@
 # (envs/control/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
 # order, each started from the one before. Every run is deterministic (its seed, its tuning
 # conditions), so the chain ends with the committed parameters, bit for bit; the last line
-# checks it. About 140 minutes on 2 cores. Usage:
+# checks it. About 175 minutes on 2 cores. Usage:
 #     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
 # then `cp OUT/final/gains.json envs/control/gains.json` makes the result the controller's gains.
 set -euo pipefail
@@ -38,6 +38,43 @@ stage w3 --gait walk --conditions 12 --gens 60 --pop 16 --sigma 0.05 --seed 24
 # ... and a finer step over all 16 conditions: after w3 the walk fell under one of the four
 # last (another walk network at friction x1.25, or the closed loop with a push).
 stage w4 --gait walk --conditions 16 --gens 30 --pop 16 --sigma 0.03 --seed 26
+# The jump (README, "Start-up gains"; stages j1 and j2 of scripts/tune_jump_experiment.sh): its
+# corner set by hand to a countermovement, searched alone, then scored on the walk too.
+walk_end="$prev"
+python3 - "$OUT" "$prev" <<'PY'
+import sys
+from cpgbiped.envs.search.controller_tuning import set_by_hand
+out, prev = sys.argv[1], sys.argv[2]
+set_by_hand(prev, {"synchronous.theta0": 0.0}, f"{out}/set1/gains.json",
+            "the jump corner aims the thighs straight down (theta0 0.22 put each landing ahead "
+            "of the centre of mass: backward drift and falls)")
+set_by_hand(f"{out}/set1/gains.json", {"synchronous.knee_crouch": -0.5,
+                                       "synchronous.pitch_d": 0.1}, f"{out}/set2/gains.json",
+            "a countermovement: the jump corner crouches to -0.5 rad outside the extensor burst "
+            "(it stood at -0.15: the legs stayed straight and only the ankles pushed), with the "
+            "trunk nearer upright (pitch target 0.1 rad, was 0.24) so that the take-off does "
+            "not pitch it forward")
+PY
+prev="$OUT/set2/gains.json"
+stage jx1 --gait jump --conditions 8 --gens 60 --pop 24 --sigma 0.2 --seed 62
+stage jx2 --gait walk,jump --only 'synchronous.*' --conditions 1-8,21-24 --gens 30 --pop 16 --sigma 0.05 --seed 63
+# Start-up gains: the corners the chain had before the jump's stages start the body and hand
+# over to jx2's; tau_s chosen on CPG seeds 2000-2099 by a rule fixed in advance (3 minutes).
+python3 scripts/select_startup_tau.py --live "$prev" --startup-from "$walk_end" \
+    --out "$OUT/startup_selection.json"
+python3 - "$OUT" "$prev" "$walk_end" <<'PY'
+import json, sys
+from cpgbiped.envs.search.controller_tuning import set_startup
+out, prev, walk_end = sys.argv[1:4]
+tau = json.load(open(f"{out}/startup_selection.json"))["tau_s"]
+set_startup(prev, walk_end, tau, f"{out}/s1/gains.json",
+            "the jump corner of stage j2 jumps, but changed every walk's first steps (the "
+            "features start at a quarter of each corner); the corners the chain had before the "
+            "jump's stages (w4) start the body and hand over as exp(-t/tau_s); tau_s chosen by "
+            "scripts/select_startup_tau.py on CPG seeds 2000-2099 "
+            "(envs/control/startup_selection.json)")
+PY
+prev="$OUT/s1/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

@@ -175,12 +175,20 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     flexion stops. At 0 (the committed gains) the run's knee extends at once when it lands
     in its burst (a piston); at 1 the leg first gives: its knee flexes further in the first
     60 ms after touchdown. (At its neutral 0 it leaves the rollouts of older gains files
-    unchanged, bit for bit: tests/test_feedback.py's recorded rows.)"""
+    unchanged, bit for bit: tests/test_feedback.py's recorded rows.) The landings counted are
+    those after 2 s; the corner's gain is set in the start-up gains too, so that it acts from
+    the start rather than as they hand over."""
+    from dataclasses import replace
+
     from cpgbiped.envs.simulation.rollout import rollout
 
     give = {}
     for y in (0.0, 1.0):
         p = CONTROL.with_corner("alternating_coactive", land_yield=y)
+        if p.startup is not None:
+            k = K.CORNERS.index("alternating_coactive")
+            p = replace(p, startup=tuple(replace(c, land_yield=y) if i == k else c
+                                         for i, c in enumerate(p.startup)))
         rec = rollout(build("ml", "run"), 5.0, p, poses=False, stop_on_fall=False)
         n = int(round(0.06 / (rec.t[1] - rec.t[0])))
         flex = []

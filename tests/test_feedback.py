@@ -137,13 +137,14 @@ def test_the_thigh_angle_pathway_is_gated_by_ground_contact():
 
 def test_the_phase_response_moves_the_cpg_only_with_feedback():
     """Open loop the network never hears the body: a push leaves its phase exactly where it
-    was. With Tegotae feedback (Hopf run, K = 3) a 10 N s push moves it."""
+    was. With Tegotae feedback (Hopf run, K = 3) a 10 N s push moves it, at each phase tried,
+    by more than a hundredth of a cycle (numerical noise is far below: open loop it is 0)."""
     from cpgbiped.envs.experiments.phase_response import phase_response
 
     net = build("hopf", "run")
     open_, closed = (phase_response(net, K, phases=(0.1, 0.4), impulse=10.0) for K in (0.0, 3.0))
     assert open_["dphi"] == [0.0, 0.0]
-    assert max(abs(x) for x in closed["dphi"]) > 0.05
+    assert min(abs(x) for x in closed["dphi"]) > 0.01, closed["dphi"]
 
 
 def _cli(*args, timeout=300):
@@ -214,15 +215,13 @@ def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fa
 
 
 # -- what issue 21 asks and the closed loop does not reach (measured, README "Feedback") ----
-@pytest.mark.xfail(raises=AssertionError, strict=True,
-                   reason="with feedback (K = 0.01) the jump falls in 12 of the 13 test "
-                          "conditions (open loop 10 of 13; Table 3 state at 4.1 s): the jump's "
-                          "shortfall of issue 20, which the feedback does not repair")
 def test_the_jump_survives_the_test_conditions_with_feedback():
+    """Issue 21: with feedback at the recommended gain the jump preset does not fall in any of
+    the 13 test conditions (22 s each)."""
     from tests.test_physics import CONDITIONS
 
     fell = 0
-    for cond in CONDITIONS[:4]:
+    for cond in CONDITIONS:
         cond = dict(cond)
         rec = rollout(build("ml", "jump", seed=cond.pop("seed", None)), 22.0, poses=False,
                       feedback=RECOMMENDED["ml"], **cond)
@@ -244,11 +243,7 @@ def test_feedback_doubles_the_forward_push_envelope_or_reaches_half_a_newton_sec
         assert c >= 2 * o or c >= 0.5 * 21.0, (preset, o, c)
 
 
-@pytest.mark.parametrize("preset", ["walk", "run", pytest.param("jump", marks=pytest.mark.xfail(
-    raises=AssertionError, strict=True,
-    reason="with feedback the jump falls at 4.1 s (open loop at 6.1 s): the 2.1 s of cell "
-           "outputs after settling are too few for the classifier (named none; kept running "
-           "after the fall, the closed-loop cells are named jump)")), "hop"])
+@pytest.mark.parametrize("preset", ["walk", "run", "jump", "hop"])
 def test_the_cpg_classifier_names_each_preset_from_the_closed_loop_cells(preset):
     """Feedback may move the network, but at the recommended gain the four cells still make
     the preset's gait (the gait table's phases, named by cpg.gaits.classify)."""
