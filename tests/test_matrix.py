@@ -21,7 +21,7 @@ KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
     "ml-random-jump": ("falls at 0.94 s, in the CPG's start-up transient", True),
     "ml-random-hop": ("falls at 1.42 s, in the CPG's start-up transient", True),
     "hopf-walk": (_WALK.format("0.51/0.53", "0.04", "19.3"), True),
-    "hopf-jump": ("falls; before it, no flight, named none", True),
+    "hopf-jump": ("falls; before it, jumps of 11% flight, named none", True),
 }
 RANDOM_SEED = 7
 
