@@ -32,7 +32,7 @@ def test_apex_from_the_recorded_com_height():
     the centre of mass rises v^2 / (2 g) above its take-off height, v its vertical speed at
     take-off. Flights here come from the raw contact forces (no debounce), 40 ms or longer;
     take-off speeds from central differences of the recorded height. (The hop: the two-legged
-    gait that flies every cycle without a fall; the jump preset falls, README "Status".)"""
+    gait with the most regular flights, README "Status".)"""
     v = validate(build("ml", "hop"), "hop", 10.0)
     rec = v.recording
     sel = np.flatnonzero(rec.t >= v.settle_s)

@@ -57,7 +57,7 @@ def test_matrix_table_counts_the_diagonal():
 
 
 @pytest.mark.xfail(strict=True, raises=AssertionError, reason="2 of 4: run and hop; the walk is "
-                   "named none (duty 0.51/0.53), the jump falls")
+                   "named none (duty 0.51/0.53), the jump falls after jumps of 11% flight")
 def test_hopf_matrix_is_mostly_diagonal():
     """At least 3 of the 4 Hopf presets give their own physical gait (issue 20)."""
     rows = cached("hopf")["rows"]
