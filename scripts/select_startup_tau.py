@@ -21,19 +21,12 @@ import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from census import one  # noqa: E402  (gait, seed, summary, failures) of one validated rollout
+
 CANDIDATES = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0)
 WALK_SEEDS = range(2000, 2100)
 JUMP_SEEDS = range(2000, 2050)
-
-
-def one(job):
-    gait, seed, gains = job
-    from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import read_gains
-    from cpgbiped.envs.gaits.validate import validate
-
-    s = validate(build("ml", gait, seed=seed), gait, 20.0, params=read_gains(gains)[0]).summary()
-    return gait, seed, s["physical_gait"] == gait, not s["failures"], s["fell_at_s"] is not None
 
 
 def main() -> None:
@@ -54,9 +47,11 @@ def main() -> None:
             res = list(ex.map(one, jobs))
             walk = [r for r in res if r[0] == "walk"]
             jump = [r for r in res if r[0] == "jump"]
-            row = {"tau_s": tau, "walk_passes": sum(r[3] for r in walk),
-                   "walk_falls": sum(r[4] for r in walk), "jump_named": sum(r[2] for r in jump),
-                   "jump_falls": sum(r[4] for r in jump), "n_walk": len(walk), "n_jump": len(jump)}
+            fell = lambda rows: sum(r[2]["fell_at_s"] is not None for r in rows)  # noqa: E731
+            row = {"tau_s": tau, "walk_passes": sum(not r[3] for r in walk),
+                   "walk_falls": fell(walk),
+                   "jump_named": sum(r[2]["physical_gait"] == "jump" for r in jump),
+                   "jump_falls": fell(jump), "n_walk": len(walk), "n_jump": len(jump)}
             row["score"] = (row["walk_passes"] + row["jump_named"]
                             - 3 * (row["walk_falls"] + row["jump_falls"]))
             rows.append(row)

@@ -41,20 +41,7 @@ stage w4 --gait walk --conditions 16 --gens 30 --pop 16 --sigma 0.03 --seed 26
 # The jump (README, "Start-up gains"; stages j1 and j2 of scripts/tune_jump_experiment.sh): its
 # corner set by hand to a countermovement, searched alone, then scored on the walk too.
 walk_end="$prev"
-python3 - "$OUT" "$prev" <<'PY'
-import sys
-from cpgbiped.envs.search.controller_tuning import set_by_hand
-out, prev = sys.argv[1], sys.argv[2]
-set_by_hand(prev, {"synchronous.theta0": 0.0}, f"{out}/set1/gains.json",
-            "the jump corner aims the thighs straight down (theta0 0.22 put each landing ahead "
-            "of the centre of mass: backward drift and falls)")
-set_by_hand(f"{out}/set1/gains.json", {"synchronous.knee_crouch": -0.5,
-                                       "synchronous.pitch_d": 0.1}, f"{out}/set2/gains.json",
-            "a countermovement: the jump corner crouches to -0.5 rad outside the extensor burst "
-            "(it stood at -0.15: the legs stayed straight and only the ankles pushed), with the "
-            "trunk nearer upright (pitch target 0.1 rad, was 0.24) so that the take-off does "
-            "not pitch it forward")
-PY
+python3 scripts/jump_countermovement.py "$prev" "$OUT"
 prev="$OUT/set2/gains.json"
 stage jx1 --gait jump --conditions 8 --gens 60 --pop 24 --sigma 0.2 --seed 62
 stage jx2 --gait walk,jump --only 'synchronous.*' --conditions 1-8,21-24 --gens 30 --pop 16 --sigma 0.05 --seed 63

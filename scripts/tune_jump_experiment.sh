@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # An experiment, not the committed gains: a jump with a countermovement, searched while the
-# walk scores it (README "The jump's falls, traced and tried"). From the committed gains file,
+# walk scores it (README "The jump's falls, traced and tried"). From stage w4 of
+# scripts/tune_gains.sh (the gains before the jump was adopted; START),
 # by hand (links of the chain with their provenance, set_by_hand): the jump's corner aims the
 # thighs straight down (theta0 0; 0.22 put every landing ahead of the centre of mass), crouches
 # to -0.5 rad outside the extensor burst (it stood at -0.15: the legs stayed straight) and holds
@@ -10,25 +11,17 @@
 # rhythm); then two stages of the walk's corner (w5, w6). About 45 minutes on 2 cores.
 # Results: OUT/<stage>/ (default out/jump_experiment); drive the body with one as
 # scripts/tune_run_experiment.sh says.
-# Usage: bash scripts/tune_jump_experiment.sh [OUT]
+# Usage: bash scripts/tune_jump_experiment.sh [OUT] [START]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-out/jump_experiment}
-mkdir -p "$OUT/set1" "$OUT/set2"
-python3 - "$OUT" <<'PY'
-import sys
-from cpgbiped.envs.search.controller_tuning import set_by_hand
-out = sys.argv[1]
-set_by_hand("envs/control/gains.json", {"synchronous.theta0": 0.0}, f"{out}/set1/gains.json",
-            "the jump corner aims the thighs straight down (theta0 0.22 put each landing ahead "
-            "of the centre of mass: backward drift and falls)")
-set_by_hand(f"{out}/set1/gains.json", {"synchronous.knee_crouch": -0.5,
-                                       "synchronous.pitch_d": 0.1}, f"{out}/set2/gains.json",
-            "a countermovement: the jump corner crouches to -0.5 rad outside the extensor burst "
-            "(it stood at -0.15: the legs stayed straight and only the ankles pushed), with the "
-            "trunk nearer upright (pitch target 0.1 rad, was 0.24) so that the take-off does "
-            "not pitch it forward")
-PY
+START=${2:-out/tune_chain/w4/gains.json}
+if [ ! -f "$START" ]; then
+  echo "tune_jump_experiment: $START is missing: it starts from the chain's stage w4 (the gains" >&2
+  echo "before the jump was adopted); run scripts/tune_gains.sh, or name a start file" >&2
+  exit 2
+fi
+python3 scripts/jump_countermovement.py "$START" "$OUT"
 prev="$OUT/set2/gains.json"
 stage() {  # stage NAME ARGS...: one tune run started from the previous stage's gains
   local name=$1; shift
