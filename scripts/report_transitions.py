@@ -5,7 +5,10 @@ ramp, open loop and with the recommended feedback; the drive sweeps walk<->run a
                                          [--img docs/img]
 
 The change comes at 8 s (after 6 s of the first gait), the rollout ends 12 s after the change
-ends. Writes OUT/report.md, OUT/report.json and the sweep pictures (also into --img).
+ends. The in-family steps are repeated with the change at 9-14 s: the body is chaotic, and
+one time of change says little about the next (issue 22's test: no fall, A named before the
+change, B within 4 CPG cycles after it). Writes OUT/report.md, OUT/report.json and the sweep
+pictures (also into --img).
 """
 from __future__ import annotations
 
@@ -20,12 +23,32 @@ GAITS = ("walk", "run", "jump", "hop")
 IN_FAMILY = {("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump")}
 
 
+AT_S = (8.0, 9.0, 10.0, 11.0, 12.0, 13.0, 14.0)  # times of the change for the in-family steps
+PASS_CYCLES = 4  # issue 22: B within 4 CPG cycles of the change
+
+
 def _one(job):
-    a, b, ramp, K = job
+    a, b, ramp, K, at = job
     from cpgbiped.envs.experiments.transition import transition
 
-    res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0, K)
+    res, *_ = transition("ml", a, b, at, ramp, at + ramp + 12.0, K)
     return res
+
+
+def passes(r) -> bool:
+    """Issue 22's test: no fall, A named before the change, B within PASS_CYCLES cycles."""
+    return (not r["fell"] and r["before"]["physical_gait"] == r["from"]
+            and r["after"]["physical_gait"] == r["to"] and r["cycles_to_switch"] is not None
+            and r["cycles_to_switch"] <= PASS_CYCLES)
+
+
+def _cell(r) -> str:
+    if r["fell"]:
+        return "fell %.1f s" % r["fell_at_s"]
+    c = r["cycles_to_switch"]
+    txt = f"{r['before']['physical_gait']} -> {r['after']['physical_gait']}"
+    txt += "" if c is None else f", {c} cycles"
+    return f"**{txt}**" if passes(r) else txt
 
 
 def _sweep(job):
@@ -48,11 +71,14 @@ def main(argv=None) -> int:
 
     out = ensure_dir(a.out)
     K = RECOMMENDED["ml"]
-    jobs = [(x, y, r, k) for x in GAITS for y in GAITS if x != y for r in (0.0, 2.0)
+    jobs = [(x, y, r, k, AT_S[0]) for x in GAITS for y in GAITS if x != y for r in (0.0, 2.0)
             for k in (0.0, K)]
+    later = [(x, y, 0.0, k, at) for x, y in sorted(IN_FAMILY) for k in (0.0, K)
+             for at in AT_S[1:]]
     sweeps = [(p, k) for p in ("walk-run", "jump-hop") for k in (0.0, K)]
     with ProcessPoolExecutor(a.workers) as ex:
         rows = list(ex.map(_one, jobs))
+        times = list(ex.map(_one, later))
         sw = list(ex.map(_sweep, sweeps))
     md = ["### Transitions (Morris-Lecar, change at 8 s)", "",
           "before / after: the physical gait the contacts name before the change and once it "
@@ -72,6 +98,18 @@ def main(argv=None) -> int:
                   f"{'%.1f s' % r['fell_at_s'] if r['fell'] else 'no'} | "
                   f"{'-' if r['cycles_to_switch'] is None else r['cycles_to_switch']} | "
                   f"{outcome} |")
+    md += ["", "### In-family steps against the time of the change", "",
+           "before -> after, and the CPG cycles to the switch; in bold where issue 22's test "
+           f"passes (no fall, A before, B within {PASS_CYCLES} cycles).", "",
+           "| from -> to | K | " + " | ".join(f"{t:g} s" for t in AT_S) + " | passes |",
+           "|---|---|" + "---|" * len(AT_S) + "---|"]
+    every = rows + times
+    for x, y in sorted(IN_FAMILY):
+        for k in (0.0, K):
+            cells = [next(r for r in every if (r["from"], r["to"], r["ramp_s"], r["feedback_gain"],
+                                               r["at_s"]) == (x, y, 0.0, k, at)) for at in AT_S]
+            md.append(f"| {x} -> {y} | {k:g} | " + " | ".join(_cell(r) for r in cells)
+                      + f" | {sum(map(passes, cells))}/{len(cells)} |")
     md += ["", "### Drive sweeps (ramps of 40 s)", "",
            "| sweep | K | switch up: drive, speed, Froude | switch down: drive, speed, Froude "
            "| hysteresis (drive) | fell |", "|---|---|---|---|---|---|"]
@@ -88,7 +126,8 @@ def main(argv=None) -> int:
         img.append(p)
     text = "\n".join(md) + "\n"
     write_text(Path(out) / "report.md", text)
-    (Path(out) / "report.json").write_text(json.dumps({"transitions": rows, "sweeps": sw},
+    (Path(out) / "report.json").write_text(json.dumps({"transitions": rows, "change_times": times,
+                                                       "sweeps": sw},
                                                       indent=1, default=float))
     if a.img:
         ensure_dir(a.img)
