@@ -14,8 +14,8 @@ from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.optimize import RunSettings
 from cpgbiped.envs.gaits import gait_metrics as gm
 from cpgbiped.envs.control.controller import CONTROL, GAINS_FILE, read_gains
-from cpgbiped.envs.search.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, MAX_CONDITIONS,
-                                    ROOT_GAINS_FILE, TuneSettings,
+from cpgbiped.envs.search.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, HORIZON,
+                                    MAX_CONDITIONS, ROOT_GAINS_FILE, TuneSettings,
                                     check_gaits, rollout_cost, target_speed, tune,
                                     tuning_conditions, variables)
 from cpgbiped.envs.gaits.criteria import CRITERIA
@@ -235,6 +235,45 @@ def test_small_run_writes_a_gains_file_and_resumes_identically(tmp_path, algorit
     assert p.synchronous_coactive != root.synchronous_coactive
     history = (tmp_path / "full" / "tune_history.csv").read_text().splitlines()
     assert len(history) == 1 + SMALL["gens"]
+
+
+class _FallsBeyondTheWindow(SerialRunner):
+    """Real rollouts for the tuned window; a longer rollout is reported as a fall 1.5 windows
+    after the settling: a stand-in for a gait that drifts out of itself after the window."""
+
+    def __call__(self, trials):
+        out = super().__call__(trials)
+        seconds, settle_s, _ = self.args
+        if seconds > self.window:
+            for s in out:
+                s["fell"], s["survived_s"] = True, settle_s + 1.5 * self.window
+        return out
+
+
+def test_horizon_check_reports_falls_after_the_tuned_window(tmp_path):
+    """The best point is rolled out again for HORIZON windows: a fall there is reported (in the
+    provenance and tune_conditions.csv) although the search never saw it, the runner's
+    window is restored, and the search's result is the one it would be without the check."""
+    import csv
+
+    from cpgbiped.envs.gaits.criteria import SETTLE_S
+
+    s = TuneSettings(("hop",), seconds=2.0, n_conditions=2)
+    rs = RunSettings(pop=4, gens=1, seed=5, checkpoint_every=1)
+    runner = _FallsBeyondTheWindow(2.0)
+    runner.window = 2.0
+    r = tune(s, rs, tmp_path / "h", runner, start=GAINS_FILE, command="test")
+    h = r["entry"]["horizon"]
+    assert h["seconds"] == HORIZON * 2.0 and h["rollouts"] == 2 and h["fell"] == 2
+    assert h["fell_at_s"] == [SETTLE_S + 3.0] * 2
+    assert runner.args[0] == 2.0
+    with open(tmp_path / "h" / "tune_conditions.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [float(x["fell_at_s_horizon"]) for x in rows] == [SETTLE_S + 3.0] * 2
+    plain = tune(s, rs, tmp_path / "p", SerialRunner(2.0), start=GAINS_FILE, command="test")
+    assert plain["entry"]["result_sha256"] == r["entry"]["result_sha256"]
+    assert plain["entry"]["horizon"]["fell"] == sum(x is not None for x in
+                                                    plain["entry"]["horizon"]["fell_at_s"])
 
 
 def test_the_controller_loads_one_chain_of_tuning_runs():

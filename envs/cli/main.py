@@ -405,7 +405,8 @@ def only_arg(text: str) -> tuple[str, ...]:
 def cmd_tune(a) -> int:
     from cpgbiped.cpg.optimize import RunSettings
     from cpgbiped.envs.control.controller import GAINS_FILE
-    from cpgbiped.envs.search.controller_tuning import TuneSettings, check_gaits, tune, variables
+    from cpgbiped.envs.search.controller_tuning import (HORIZON, TuneSettings, check_gaits, tune,
+                                                          variables)
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
@@ -445,6 +446,11 @@ def cmd_tune(a) -> int:
           f"{len(e['conditions'])} tuning conditions)")
     for g in settings.gaits:
         print(f"  {g}: the best point's rollouts under each condition: {a.out}/tune_conditions.csv")
+    h = e["horizon"]
+    print(f"  horizon check: rolled out for {h['seconds']:g} s, {HORIZON:g} times the tuned "
+          f"window, the best point falls in {h['fell']} of {h['rollouts']} rollouts"
+          + ("" if not h["fell"] else " (fell_at_s_horizon in tune_conditions.csv): a gait "
+             "that holds only for the window it was tuned on"))
     print(f"results in {a.out}/: gains.json (copy it to {GAINS_FILE} to make it the controller's "
           f"gains), tune_history.csv, tune_conditions.csv")
     return 0

@@ -58,6 +58,14 @@ the seed, the algorithm and budget, the conditions, the cost, the SHA-256 of the
 it started from) - the file the controller loads once copied to :data:`cpgbiped.envs.control.controller.GAINS_FILE`;
 ``tune_history.csv`` (per generation: best and median cost); ``tune_conditions.csv`` (the best
 point's metrics under every condition).
+
+The horizon check: a search scores only its window (``--seconds`` after the settling), and a
+body may drift out of a gait just after it (a run stage with 10 s windows gave a run whose
+trunk leaned further every stride and fell at 13-17 s in every test condition). So the best
+point is rolled out once more under every condition for HORIZON times the window; the time
+of any fall goes into ``tune_conditions.csv`` (``fell_at_s_horizon``, s from the start) and
+the provenance entry (``horizon``), and the command line says how many fell. It never
+changes the search or its result.
 """
 from __future__ import annotations
 
@@ -105,6 +113,7 @@ POSTURE, LEAN_FREE_DEG = 1.0, 10.0  # per 10 deg of mean trunk lean beyond 10 de
 # guard's gains by GUARD_TOL (the rollouts are deterministic, but a body this chaotic moves
 # its cost by a few hundredths for any change); each unit beyond counts GUARD times.
 GUARD, GUARD_TOL = 10.0, 0.1
+HORIZON = 2.0  # the horizon check rolls the best point out for this many windows
 ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
@@ -474,6 +483,21 @@ def algorithm_for(settings: TuneSettings, x0: np.ndarray, lo, hi, pop: int, seed
                  eliminate_duplicates=True)
 
 
+def horizon_falls(problem: "ControllerTuningProblem", x, seconds: float) -> list:
+    """The horizon check (module docstring): the fall time (s from the start; None: no fall)
+    of parameters ``x`` under each condition and gait (condition-major, as the trials) when
+    rolled out for HORIZON x ``seconds`` after the settling. The runner's window is
+    lengthened for this one batch and restored."""
+    runner = problem.runner
+    saved = runner.args
+    runner.args = (HORIZON * seconds, *saved[1:])
+    try:
+        results = runner(problem.trials(x))
+    finally:
+        runner.args = saved
+    return [round(float(r["survived_s"]), 3) if r["fell"] else None for r in results]
+
+
 def params_sha256(p: ControlParams) -> str:
     """SHA-256 of a parameter set's values (the canonical JSON of :func:`params_to_dict`):
     which gains a run started from, whatever provenance the file carried."""
@@ -534,6 +558,7 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     k = int(np.argmin(score))
     best_x, start_score = P[k], float(score[-1])
     tuned = with_values(base, problem.names, best_x)
+    late = horizon_falls(problem, best_x, settings.seconds)
     entry = {
         "searched": problem.names, "gaits": list(settings.gaits),
         "command": command, "seed": rs.seed, "algorithm": settings.algorithm,
@@ -548,6 +573,9 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                                           if settings.guard_gains else base),
             "guard_reference_costs": np.round(problem.reference_costs(), 4).tolist()}
            if settings.guard else {}),
+        "horizon": {"seconds": HORIZON * settings.seconds,
+                    "fell": sum(t is not None for t in late), "rollouts": len(late),
+                    "fell_at_s": late},
         "wall_s": round(time.perf_counter() - t0, 1),
     }
     gains = {"format": GAINS_FORMAT, **params_to_dict(tuned),
@@ -557,7 +585,7 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
               problem.history)
     head = ["gait", "network", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost",
             "fell", "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
-            "apex_height_m", "stride_cv", "ankle_excursion_deg"]
+            "apex_height_m", "stride_cv", "ankle_excursion_deg", "fell_at_s_horizon"]
     rows = []
     n_g = len(settings.gaits)
     for c, cond in enumerate(problem.conditions):
@@ -571,7 +599,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                          s["fell"], s["physical_gait"], _r(s["speed_mps"]), _r(s["froude"]),
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
-                         _r(s["ankle_excursion_deg"])])
+                         _r(s["ankle_excursion_deg"]),
+                         "" if late[c * n_g + j] is None else late[c * n_g + j]])
     write_csv(rd.path("tune_conditions.csv"), head, rows)
     return {"gains": gains, "entry": entry, "best": summaries[k], "params": tuned}
 
