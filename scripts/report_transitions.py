@@ -103,11 +103,11 @@ def main(argv=None) -> int:
            f"passes (no fall, A before, B within {PASS_CYCLES} cycles).", "",
            "| from -> to | K | " + " | ".join(f"{t:g} s" for t in AT_S) + " | passes |",
            "|---|---|" + "---|" * len(AT_S) + "---|"]
-    every = rows + times
+    step = {(r["from"], r["to"], r["feedback_gain"], r["at_s"]): r
+            for r in rows + times if r["ramp_s"] == 0.0}
     for x, y in sorted(IN_FAMILY):
         for k in (0.0, K):
-            cells = [next(r for r in every if (r["from"], r["to"], r["ramp_s"], r["feedback_gain"],
-                                               r["at_s"]) == (x, y, 0.0, k, at)) for at in AT_S]
+            cells = [step[x, y, k, at] for at in AT_S]
             md.append(f"| {x} -> {y} | {k:g} | " + " | ".join(_cell(r) for r in cells)
                       + f" | {sum(map(passes, cells))}/{len(cells)} |")
     md += ["", "### Drive sweeps (ramps of 40 s)", "",

@@ -486,15 +486,9 @@ def algorithm_for(settings: TuneSettings, x0: np.ndarray, lo, hi, pop: int, seed
 def horizon_falls(problem: "ControllerTuningProblem", x, seconds: float) -> list:
     """The horizon check (module docstring): the fall time (s from the start; None: no fall)
     of parameters ``x`` under each condition and gait (condition-major, as the trials) when
-    rolled out for HORIZON x ``seconds`` after the settling. The runner's window is
-    lengthened for this one batch and restored."""
-    runner = problem.runner
-    saved = runner.args
-    runner.args = (HORIZON * seconds, *saved[1:])
-    try:
+    rolled out for HORIZON x ``seconds`` after the settling, by the search's own runner."""
+    with problem.runner.measuring(HORIZON * seconds) as runner:
         results = runner(problem.trials(x))
-    finally:
-        runner.args = saved
     return [round(float(r["survived_s"]), 3) if r["fell"] else None for r in results]
 
 

@@ -19,6 +19,7 @@ import math
 import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -193,6 +194,17 @@ class SerialRunner:
 
     def __call__(self, trials: list[Trial]) -> list[TrialResult]:
         return _run_chunk((list(trials), *self.args))
+
+    @contextmanager
+    def measuring(self, seconds: float):
+        """Within the block, roll trials out for ``seconds`` after the settling instead (the same
+        workers); the window is restored on the way out."""
+        saved = self.args
+        self.args = (float(seconds), *saved[1:])
+        try:
+            yield self
+        finally:
+            self.args = saved
 
     def close(self):
         pass
