@@ -74,35 +74,45 @@ def staged(path: str | os.PathLike) -> Path:
 
 
 @contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM are held back inside this block (recorded, then raised again at its
+    end): for short stretches that must not be cut in two, such as the renames of a set of
+    files or the creation of an OpenGL context whose half-built object would print a traceback
+    from its finaliser. A Python-level deferral: a blocked signal mask would not stop the
+    kernel from handing the signal to another thread (BLAS, ffmpeg readers) and Python then
+    running the handler inside the block. Outside the main thread it holds nothing."""
+    held: list[int] = []
+    old: dict = {}
+    try:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                old[sig] = signal.signal(sig, lambda signum, frame: held.append(signum))
+        yield
+    finally:
+        for sig, handler in old.items():
+            if handler is not None:
+                signal.signal(sig, handler)
+    for sig in held[:1]:
+        signal.raise_signal(sig)
+
+
+@contextmanager
 def all_or_nothing() -> Iterator[None]:
     """Every file written with :func:`atomic_path` in this block lands at its end, together;
     on an error or interrupt none does and the temporary files go."""
-    # SIGINT and SIGTERM are held back while the renames run (recorded, then raised again):
-    # a Python-level deferral, since a blocked signal mask would not stop the kernel from
-    # handing the signal to another thread (BLAS, ffmpeg readers) and Python then running the
-    # handler between two renames.
     pending: list = []
-    held: list[int] = []
-    old: dict = {}
     token = _PENDING.set(pending)
     try:
         try:
             yield
         finally:
             _PENDING.reset(token)
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                old[sig] = signal.signal(sig, lambda signum, frame: held.append(signum))
-        for tmp, final in pending:
-            os.replace(tmp, final)
+        with signals_held():  # the renames run as one
+            for tmp, final in pending:
+                os.replace(tmp, final)
     finally:
-        for sig, handler in old.items():
-            if handler is not None:
-                signal.signal(sig, handler)
         for tmp, _ in pending:
             tmp.unlink(missing_ok=True)  # renamed ones are gone; the rest never land
-    for sig in held[:1]:
-        signal.raise_signal(sig)
 
 
 def _default(o):

@@ -698,6 +698,22 @@ def _render_set(folder) -> dict:
             for f in sorted(os.listdir(folder)) if f.startswith("r")}
 
 
+def test_signals_held_defers_an_interrupt_to_the_end_of_its_block():
+    """A Ctrl-C that arrives inside signals_held() (the OpenGL context's creation, the renames
+    of a set of files) lets the block finish and is raised once at its end; the handler that
+    was in place before is back afterwards."""
+    from cpgbiped.cpg.io import signals_held
+
+    before, ran = signal.getsignal(signal.SIGINT), []
+    with pytest.raises(KeyboardInterrupt):
+        with signals_held():
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(1000):  # bytecode boundaries where an unheld handler would run
+                time.sleep(0)
+            ran.append("finished")
+    assert ran == ["finished"] and signal.getsignal(signal.SIGINT) is before
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_render_s_video_pictures_and_recording_land_together(tmp_path, sig):
     """A render interrupted at moments spread over its run leaves its folder holding the

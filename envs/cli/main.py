@@ -1284,12 +1284,44 @@ class Terminated(KeyboardInterrupt):
 _SIGNALLED: list[int] = []  # signals received during this run of main()
 
 
+# Where an exception raised by a signal handler would be swallowed ("Exception ignored ...")
+# or would corrupt a native library's state: numba's compiler and llvmlite's ctypes callbacks
+# (sometimes a segfault or exit -2 after), weakref callbacks run by the garbage collector (the
+# interrupt lost: the run carried on and ended with exit 0).
+_SWALLOWING = (f"{os.sep}numba{os.sep}", f"{os.sep}llvmlite{os.sep}", f"{os.sep}weakref.py",
+               f"{os.sep}_weakrefset.py")
+RESEND_S = 0.05  # how soon a signal put off is sent again
+
+
+def _put_off(signum, frame) -> bool:
+    """True (and the signal sent to this process again in RESEND_S) when it arrived where an
+    exception would be swallowed or would corrupt a library (``_SWALLOWING``, or a finaliser
+    ``__del__``). Measured with scripts/check_interrupts.py: 4 of 150 Ctrl-Cs sent 0.5-1.3 s
+    into a render (numba loading its kernels) ended with a traceback, a segfault or exit -2;
+    Ctrl-Cs 2.6-3.6 s into it were sometimes lost in a weakref callback."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "__del__" or any(d in code.co_filename for d in _SWALLOWING):
+            import threading
+
+            t = threading.Timer(RESEND_S, os.kill, (os.getpid(), signum))
+            t.daemon = True
+            t.start()
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _on_sigterm(signum, frame):
+    if _put_off(signum, frame):
+        return
     _SIGNALLED.append(signum)
     raise Terminated()
 
 
 def _on_sigint(signum, frame):
+    if _put_off(signum, frame):
+        return
     _SIGNALLED.append(signum)
     raise KeyboardInterrupt()
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.cpg.io import atomic_path
+from cpgbiped.cpg.io import atomic_path, signals_held
 
 BACKENDS = {"osmesa": ("libOSMesa", "libosmesa6"), "egl": ("libEGL", "libegl1")}
 CAM_DISTANCE, CAM_LOOKAT_Z = 2.3, 0.68  # m: the tracking camera (side view, 10 deg down)
@@ -31,8 +31,8 @@ def check_backend() -> str:
     try:
         import mujoco
 
-        with mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8):
-            pass
+        with signals_held():  # see FrameRenderer: a context cut in two prints a traceback
+            mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8).close()
     except Exception as e:  # noqa: BLE001 - any backend failure is reported in one line
         lib, pkg = BACKENDS.get(gl, ("an X display", "xvfb"))
         raise InputError(f"off-screen rendering with MUJOCO_GL={gl} failed ({type(e).__name__}): "
@@ -106,7 +106,11 @@ class FrameRenderer:
         check_backend()
         self.model = mujoco.MjModel.from_xml_path(str(xml_path or BIPED_SCENE))
         self.data = mujoco.MjData(self.model)
-        self.renderer = mujoco.Renderer(self.model, height, width)
+        # An interrupt landing inside the OpenGL context's creation or release would leave a
+        # half-built osmesa context whose finaliser prints a traceback after the one-line
+        # "interrupted" (seen once in CI): both are held to their end.
+        with signals_held():
+            self.renderer = mujoco.Renderer(self.model, height, width)
         self.cam = mujoco.MjvCamera()
         self.cam.type = mujoco.mjtCamera.mjCAMERA_FREE
         # The body (about 1.45 m tall) fills about four fifths of the picture's height (a
@@ -140,7 +144,8 @@ class FrameRenderer:
         return self.renderer.render()  # a new array each call
 
     def close(self):
-        self.renderer.close()
+        with signals_held():
+            self.renderer.close()
 
     def __enter__(self):
         return self
