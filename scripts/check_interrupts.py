@@ -12,8 +12,9 @@ Exit status 0 when no run ended badly, 1 otherwise.
 
 The test suite interrupts a render at eight moments per signal; a rare race there fails CI
 once in many runs. This script measures such races at a rate the suite cannot: the window
-0.5-1.3 s after start covers numba's loading of the compiled kernels, where 4 of 150 Ctrl-Cs
-ended badly before the CLI's handlers learnt to put a signal off while the compiler runs;
+0.5-1.3 s after start covers numba's loading of the compiled kernels, where 9 of 150 Ctrl-Cs
+(seed 3) ended badly before the CLI's handlers learnt to put a signal off while the compiler
+runs;
 2.6-3.6 s covers the writing of the outputs, where an interrupt could be lost in a weakref
 callback (exit 0 with "Exception ignored" on stderr).
 """

@@ -706,9 +706,9 @@ def test_ctrl_c_inside_numba_is_put_off_and_sent_again():
     from cpgbiped.envs.cli import main as cli
 
     ns: dict = {}
-    exec(compile("def inside(handler, frame_of):\n    handler(2, frame_of())\n",
+    exec(compile("def inside(handler, signum, frame_of):\n    handler(signum, frame_of())\n",
                  os.sep + os.path.join("x", "numba", "core", "fake.py"), "exec"), ns)
-    ns["inside"](cli._on_sigint, sys._getframe)  # no exception here
+    ns["inside"](cli._on_sigint, signal.SIGINT, sys._getframe)  # no exception here
     with pytest.raises(KeyboardInterrupt):  # the signal sent again, under pytest's handler
         time.sleep(50 * cli.RESEND_S)
     with pytest.raises(KeyboardInterrupt):

@@ -1296,8 +1296,9 @@ RESEND_S = 0.05  # how soon a signal put off is sent again
 def _put_off(signum, frame) -> bool:
     """True (and the signal sent to this process again in RESEND_S) when it arrived where an
     exception would be swallowed or would corrupt a library (``_SWALLOWING``, or a finaliser
-    ``__del__``). Measured with scripts/check_interrupts.py: 4 of 150 Ctrl-Cs sent 0.5-1.3 s
-    into a render (numba loading its kernels) ended with a traceback, a segfault or exit -2;
+    ``__del__``). Measured with scripts/check_interrupts.py (seed 3): 9 of 150 Ctrl-Cs sent
+    0.5-1.3 s into a render (numba loading its kernels) ended with exit -2 or a "Fatal Python
+    error";
     Ctrl-Cs 2.6-3.6 s into it were sometimes lost in a weakref callback."""
     while frame is not None:
         code = frame.f_code
