@@ -73,3 +73,65 @@ def test_cost_of_transport_from_force_times_velocity(walk):
     assert s["positive_work_J"] == pytest.approx(work, rel=0.1)
     assert s["cost_of_transport"] == pytest.approx(work / (mass * G * abs(s["distance_m"])),
                                                    rel=0.1)
+
+
+def test_recorded_ground_force_accounts_for_the_momentum():
+    """Newton's second law on the whole body: the feet are the only things touching the floor,
+    so the horizontal ground reaction forces the recorder logs must add up to the change of
+    the body's momentum, m (v_B - v_A), with each window's mean speed taken from the recorded
+    centre-of-mass positions alone. The run, from standing (0-1 s) to full speed (7-8 s): a
+    change of about 27 N s. The force is sampled once per 4 ms control tick (one of its two
+    physics steps), so a landing's impact shorter than that aliases: measured within 6%; a
+    force with its sign turned would miss by 200%."""
+    rec = validate(build("ml", "run"), "run", 7.0).recording
+    _, mass, _, _ = body_constants()
+    impulse = np.cumsum(rec.grf_x.sum(axis=1)) * rec.dt  # N s from t = 0
+
+    def window(t0, t1):
+        i0, i1 = np.searchsorted(rec.t, t0), np.searchsorted(rec.t, t1)
+        return i0, i1, (rec.com_x[i1] - rec.com_x[i0]) / (rec.t[i1] - rec.t[i0])
+
+    a0, a1, v_a = window(0.0, 1.0)
+    b0, b1, v_b = window(7.0, 8.0)
+    n = min(a1 - a0, b1 - b0)
+    # mean over s in [0, T) of J(t_B + s) - J(t_A + s) = m (mean v over B - mean v over A)
+    from_forces = float(np.mean(impulse[b0:b0 + n] - impulse[a0:a0 + n]))
+    assert mass * (v_b - v_a) > 15.0  # the run did speed up
+    assert from_forces == pytest.approx(mass * (v_b - v_a), rel=0.15)
+
+
+def test_stance_impulses_split_each_stance_at_its_middle():
+    """Hand-made contacts and forces (dt 10 ms). Left foot: a touchdown bounce (tick 3), a
+    one-tick gap (tick 4, shorter than the 30 ms debounce, so it is closed and the bounce's
+    braking counts), then contact to tick 12: a 10-tick stance, ticks 3-7 its first half at
+    -100 N (the gap carries no force), ticks 8-12 its second at +50 N. Right foot: a 6-tick
+    stance at +20 N, and one cut by the window's end, which is left out."""
+    from cpgbiped.envs.gaits.gait_metrics import stance_impulses
+
+    dt = 0.01
+    c = np.zeros((30, 2), bool)
+    f = np.zeros((30, 2))
+    c[3, 0] = True
+    c[5:13, 0] = True
+    f[[3, 5, 6, 7], 0] = -100.0
+    f[8:13, 0] = 50.0
+    c[10:16, 1] = True
+    f[10:16, 1] = 20.0
+    c[27:, 1] = True
+    f[27:, 1] = 999.0
+    first, second = stance_impulses(c, f, dt)
+    # stances: left (4 x -1.0, 5 x +0.5) = (-4.0, +2.5) N s, right (0.6, 0.6) N s; the
+    # medians of two values are their means
+    assert first == pytest.approx((-4.0 + 0.6) / 2)
+    assert second == pytest.approx((2.5 + 0.6) / 2)
+
+
+def test_the_run_brakes_then_propels_and_the_hop_pushes_backwards():
+    """A gait moving forwards at a steady speed brakes in the first half of each stance and
+    propels in the second (Cavagna et al. 1976 for human running); the hop, which drifts
+    backwards, is braked while it lands and pushed backwards while it takes off (README, hop)."""
+    run = validate(build("ml", "run"), "run", 8.0).summary()
+    assert run["stance_impulse_first_half_Ns"] < 0 < run["stance_impulse_second_half_Ns"]
+    hop = validate(build("ml", "hop"), "hop", 8.0).summary()
+    assert hop["speed_mps"] < 0
+    assert hop["stance_impulse_first_half_Ns"] > 0 > hop["stance_impulse_second_half_Ns"]

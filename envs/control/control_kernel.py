@@ -69,10 +69,14 @@ MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
 # mechanical power (actuator force x actuator velocity, W; the actuator order of the model);
 # R_FB: the feedback term each cell receives (cpg.feedback.inputs; zero open loop), computed
 # with the row's CPG outputs from the sensors of the row before (a row's state is measured at
-# the end of its tick).
+# the end of its tick). R_GRF_X: the horizontal ground reaction force on each foot (N, > 0
+# forwards; the contact sensor's net force, which MuJoCo gives as the foot's force on the floor
+# in world axes, with its sign turned).
 (R_T, R_CONTACT, R_FORCE, R_V, R_DRIVE, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX, R_COMZ,
- R_MODE, R_CTRL, R_POWER, R_FB) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37, 45)
-R_SIZE = 49
+ R_MODE, R_CTRL, R_POWER, R_FB, R_GRF_X) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37,
+                                            45, 49)
+R_SIZE = 51
+SENSOR_FX_FROM_FZ = -2  # the contact sensor's force x lies two slots before its z (found, x y z)
 
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (biped.xml)
@@ -365,6 +369,7 @@ def record(k, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, fb, S, rec
     for i in range(2):
         f = abs(sens[ix[IX_FORCE + i]])
         r[R_FORCE + i] = f
+        r[R_GRF_X + i] = -sens[ix[IX_FORCE + i] + SENSOR_FX_FROM_FZ]
         r[R_CONTACT + i] = 1.0 if f > CONTACT_N else 0.0
         r[R_MODE + i] = S[S_MODE + i]
     for c in range(4):

@@ -226,6 +226,13 @@ class Biomechanics:
                             its foot is on the ground) at the hip, knee and ankle
     trunk_lean_deg          mean torso pitch over the window (deg, > 0 leaning forward; NaN
                             when no pitch was given)
+    stance_impulse_first_half_Ns, stance_impulse_second_half_Ns
+                            median over the stances of both feet of the horizontal impulse of
+                            the ground on the foot, integral of F_x dt, in the first and in the
+                            second half of the stance (N s, > 0 forwards; NaN without the
+                            forces): a gait moving forwards brakes in the first half (< 0) and
+                            propels in the second (> 0), as in human walking and running; a
+                            push that points backwards shows as a second half < 0
     """
 
     froude: float
@@ -239,6 +246,8 @@ class Biomechanics:
     period2_index: float
     stance_work_share: dict
     trunk_lean_deg: float = float("nan")
+    stance_impulse_first_half_Ns: float = float("nan")
+    stance_impulse_second_half_Ns: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -254,6 +263,32 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
 def apex_height(com_z: np.ndarray, flight: np.ndarray) -> float:
     rises = [float(com_z[a:b].max() - com_z[a]) for a, b in runs(flight) if b - a >= 2]
     return float(np.median(rises)) if rises else 0.0
+
+
+def stance_impulses(contact: np.ndarray, grf_x: np.ndarray, dt: float,
+                    min_phase_s: float = MIN_PHASE_S) -> tuple[float, float]:
+    """(first half, second half): the median over the complete stances of both feet of the
+    impulse of ``grf_x`` (T, 2; N) on that foot in the first and in the second half of the
+    stance's ticks (N s). A stance here is a run of raw ``contact`` (T, 2) with its gaps
+    shorter than ``min_phase_s`` closed, so that every tick that carries a force belongs to a
+    stance (a touchdown's first bounce too, which :func:`debounce` would drop, and with it the
+    landing's braking); a stance cut by the window's ends is not counted."""
+    n_min = max(1, int(round(min_phase_s / dt))) if dt > 0 else 1
+    first, second = [], []
+    for i in range(2):
+        c = np.asarray(contact[:, i], bool).copy()
+        for a, b in runs(~c):
+            if a > 0 and b < len(c) and b - a < n_min:
+                c[a:b] = True
+        for a, b in runs(c):
+            if a == 0 or b == len(c) or b - a < 2:
+                continue
+            mid = a + (b - a) // 2
+            first.append(float(grf_x[a:mid, i].sum() * dt))
+            second.append(float(grf_x[mid:b, i].sum() * dt))
+    if not first:
+        return float("nan"), float("nan")
+    return float(np.median(first)), float(np.median(second))
 
 
 def stride_regularity(touchdowns: dict) -> tuple[float, float]:
@@ -272,13 +307,15 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
                  power: np.ndarray, leg_joint: np.ndarray, leg_of: np.ndarray, m: GaitMetrics,
                  leg_length_m: float, mass_kg: float, settle_s: float = 0.0,
                  min_phase_s: float = MIN_PHASE_S,
-                 pitch: np.ndarray | None = None) -> Biomechanics:
+                 pitch: np.ndarray | None = None,
+                 grf_x: np.ndarray | None = None) -> Biomechanics:
     """Biomechanics of a rollout (see :class:`Biomechanics`).
 
     power (T, n_act) W per actuator; leg_joint (n_act,) in {"hip", "knee", "ankle"} and
     leg_of (n_act,) in {0 (left), 1 (right)}: where each actuator acts. ``m``: the contact
     metrics of the same window (stride period, touchdowns, speed). pitch (T,): torso pitch
-    (rad, > 0 forward), for the trunk lean."""
+    (rad, > 0 forward), for the trunk lean. grf_x (T, 2): the horizontal ground reaction
+    force on each foot (N, > 0 forwards), for the stance impulses."""
     t = np.asarray(t, float)
     sel = t >= settle_s
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
@@ -302,6 +339,9 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         stance_work[j] = w
     total = sum(stance_work.values())
     cv, p2 = stride_regularity(m.touchdowns)
+    imp = ((float("nan"), float("nan")) if grf_x is None or len(grf_x) != len(t)
+           else stance_impulses(np.asarray(contact, bool)[sel], np.asarray(grf_x, float)[sel],
+                                dt, min_phase_s))
     return Biomechanics(
         froude=v * v / (G * leg_length_m), stride_length_m=stride,
         relative_stride_length=stride / leg_length_m, positive_work_J=work,
@@ -311,4 +351,5 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         stance_work_share={j: (w / total if total > 0 else float("nan"))
                            for j, w in stance_work.items()},
         trunk_lean_deg=(float(np.degrees(np.mean(np.asarray(pitch, float)[sel])))
-                        if pitch is not None and sel.any() else float("nan")))
+                        if pitch is not None and sel.any() else float("nan")),
+        stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1])

@@ -112,7 +112,8 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
     leg, mass, joint, side = body_constants(rec.xml_path)
     bio = biomechanics(rec.t[sel], rec.contact[sel], rec.com_x[sel], rec.com_z[sel],
                        rec.power[sel], joint, side, m, leg, mass, settle_s,
-                       pitch=rec.torso_pitch[sel])
+                       pitch=rec.torso_pitch[sel],
+                       grf_x=rec.grf_x[sel] if len(rec.grf_x) == len(rec.t) else None)
     return Validation(network, gait, rec, m, cpg_name, settle_s, ankle_drive, bio)
 
 

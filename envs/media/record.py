@@ -9,6 +9,8 @@ Entities, per rollout under ``/<name>`` (e.g. ``/walk``):
                                       and lift-off: the footfall diagram, one lane per foot
   contacts                            debounced foot contact (0/1), series left, right
   force                               normal ground reaction force (N), series left, right
+  force_x                             horizontal ground reaction force (N, > 0 forwards),
+                                      series left, right
   cpg                                 the four CPG cell outputs, series LF, RF, LE, RE
   activation                          ankle muscle activations, series LF, RF, LE, RE
   joints                              hip, knee, ankle angles (rad), series <leg>_<joint>
@@ -111,7 +113,9 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
             ("joints", JOINTS, rec.joints, JOINT_COLORS),
             ("torso", ("height", "pitch"), torso, CELL_COLORS[:2])) + (
             (("feedback", CELLS, rec.feedback, CELL_COLORS),)
-            if rec.feedback_gain > 0 and len(rec.feedback) == len(t) else ()):
+            if rec.feedback_gain > 0 and len(rec.feedback) == len(t) else ()) + (
+            (("force_x", LEGS, rec.grf_x, [FOOT_COLORS[leg] for leg in LEGS]),)
+            if len(rec.grf_x) == len(t) else ()):
         rs.log(f"/{name}/{path}", rr.SeriesLines(names=list(names), colors=list(colors)),
                static=True)
         _columns(rs, f"/{name}/{path}", t, x)

@@ -57,6 +57,8 @@ class Recording:
     xml_path: str = str(BIPED_SCENE)  # the model the rollout ran (renderers, rerun)
     feedback: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # (T, 4) per cell
     feedback_gain: float = 0.0  # K of cpg.feedback (0: open loop)
+    grf_x: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (T, 2) horizontal
+    # ground reaction force on each foot (N, > 0 forwards)
 
 
 def window(rec: Recording, t0: float, t1: float | None = None) -> Recording:
@@ -243,4 +245,4 @@ def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path,
                      col(K.R_DRIVE, 4), col(K.R_ACT, 4), col(K.R_JOINTS, 6), col(K.R_HEIGHT),
                      col(K.R_PITCH), col(K.R_COMX), col(K.R_COMZ), col(K.R_MODE, 2),
                      col(K.R_CTRL, 8), col(K.R_POWER, 8), dt * CONTROL_EVERY, dt, fell, unstable,
-                     qpos, pose, str(xml_path), col(K.R_FB, 4), gain)
+                     qpos, pose, str(xml_path), col(K.R_FB, 4), gain, col(K.R_GRF_X, 2))
