@@ -71,8 +71,9 @@ def main(argv=None) -> int:
 
     out = ["## Gait quality, Table 3 state (20 s after 2 s of settling)", "",
            "| preset | passes | speed m/s | Fr | stride s | λ/L (2.3·Fr^0.3) | duty | double "
-           "support | flight | apex cm | ankle excursion ° | stride CV | trunk lean ° |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "support | flight | apex cm | ankle excursion ° | stride CV | trunk lean ° | "
+           "horizontal impulse N s: stance 1st / 2nd half, touches per step |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for g in gaits:
         s = res[g, "table3"]
         f = fails(g, "table3")
@@ -83,7 +84,10 @@ def main(argv=None) -> int:
             f"{_f(fr, 3)} | {_f(s['stride_period_s'])} | {_f(s.get('relative_stride_length'))} "
             f"({_f(alex)}) | {_f(_duty(s))} | {_f(s['double_support'])} | {_f(s['flight'])} | "
             f"{_f(s.get('apex_height_m'), 1, 100)} | {_f(s['ankle_excursion_deg'], 0)} | "
-            f"{_f(s.get('stride_cv'), 1, 100)}% | {_f(s.get('trunk_lean_deg'), 0)} |")
+            f"{_f(s.get('stride_cv'), 1, 100)}% | {_f(s.get('trunk_lean_deg'), 0)} | "
+            f"{_f(s.get('stance_impulse_first_half_Ns'), 1)} / "
+            f"{_f(s.get('stance_impulse_second_half_Ns'), 1)}, "
+            f"{_f(s.get('touch_impulse_per_step_Ns'), 1)} |")
     out += ["", "## The 13 test conditions", "",
             "| preset | passes every criterion | failing conditions (first failure) |",
             "|---|---|---|"]

@@ -105,7 +105,9 @@ def test_stance_impulses_split_each_stance_at_its_middle():
     one-tick gap (tick 4, shorter than the 30 ms debounce, so it is closed and the bounce's
     braking counts), then contact to tick 12: a 10-tick stance, ticks 3-7 its first half at
     -100 N (the gap carries no force), ticks 8-12 its second at +50 N. Right foot: a 6-tick
-    stance at +20 N, and one cut by the window's end, which is left out."""
+    stance at +20 N, a 2-tick scuff at -300 N (shorter than half the 75th percentile of the
+    stances' 10, 6 and 2 ticks: a touch, not a stance), and a stance cut by the window's end,
+    which is left out."""
     from cpgbiped.envs.gaits.gait_metrics import stance_impulses
 
     dt = 0.01
@@ -117,13 +119,16 @@ def test_stance_impulses_split_each_stance_at_its_middle():
     f[8:13, 0] = 50.0
     c[10:16, 1] = True
     f[10:16, 1] = 20.0
+    c[20:22, 1] = True
+    f[20:22, 1] = -300.0
     c[27:, 1] = True
     f[27:, 1] = 999.0
-    first, second = stance_impulses(c, f, dt)
+    first, second, touches = stance_impulses(c, f, dt)
     # stances: left (4 x -1.0, 5 x +0.5) = (-4.0, +2.5) N s, right (0.6, 0.6) N s; the
     # medians of two values are their means
     assert first == pytest.approx((-4.0 + 0.6) / 2)
     assert second == pytest.approx((2.5 + 0.6) / 2)
+    assert touches == pytest.approx(2 * -300.0 * dt / 2)  # -6 N s over the 2 stances counted
 
 
 def test_the_run_brakes_then_propels_and_the_hop_pushes_backwards():

@@ -233,6 +233,10 @@ class Biomechanics:
                             forces): a gait moving forwards brakes in the first half (< 0) and
                             propels in the second (> 0), as in human walking and running; a
                             push that points backwards shows as a second half < 0
+    touch_impulse_per_step_Ns
+                            the horizontal impulse of the brief touches outside those stances
+                            (a swinging foot's scuff or toe drag) per stance counted (N s,
+                            < 0: they brake the body)
     """
 
     froude: float
@@ -248,6 +252,7 @@ class Biomechanics:
     trunk_lean_deg: float = float("nan")
     stance_impulse_first_half_Ns: float = float("nan")
     stance_impulse_second_half_Ns: float = float("nan")
+    touch_impulse_per_step_Ns: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -266,29 +271,36 @@ def apex_height(com_z: np.ndarray, flight: np.ndarray) -> float:
 
 
 def stance_impulses(contact: np.ndarray, grf_x: np.ndarray, dt: float,
-                    min_phase_s: float = MIN_PHASE_S) -> tuple[float, float]:
-    """(first half, second half): the median over the complete stances of both feet of the
-    impulse of ``grf_x`` (T, 2; N) on that foot in the first and in the second half of the
-    stance's ticks (N s). A stance here is a run of raw ``contact`` (T, 2) with its gaps
+                    min_phase_s: float = MIN_PHASE_S) -> tuple[float, float, float]:
+    """(first half, second half, touches): the median over the complete stances of both feet
+    of the impulse of ``grf_x`` (T, 2; N) on that foot in the first and in the second half of
+    the stance's ticks (N s), and the impulse of the brief touches left out (below), summed
+    over the window and divided by the number of stances counted (N s per step). A stance here is a run of raw ``contact`` (T, 2) with its gaps
     shorter than ``min_phase_s`` closed, so that every tick that carries a force belongs to a
     stance (a touchdown's first bounce too, which :func:`debounce` would drop, and with it the
-    landing's braking); a stance cut by the window's ends is not counted."""
+    landing's braking); a stance cut by the window's ends is not counted, nor a brief touch
+    shorter than half the 75th percentile of the stances' durations (a swinging foot's scuff,
+    which carries no weight)."""
     n_min = max(1, int(round(min_phase_s / dt))) if dt > 0 else 1
-    first, second = [], []
+    stances = []
     for i in range(2):
         c = np.asarray(contact[:, i], bool).copy()
         for a, b in runs(~c):
             if a > 0 and b < len(c) and b - a < n_min:
                 c[a:b] = True
-        for a, b in runs(c):
-            if a == 0 or b == len(c) or b - a < 2:
-                continue
+        stances += [(i, a, b) for a, b in runs(c) if 0 < a and b < len(c) and b - a >= 2]
+    if not stances:
+        return float("nan"), float("nan"), float("nan")
+    shortest = 0.5 * np.percentile([b - a for _, a, b in stances], 75)
+    first, second, touches = [], [], 0.0
+    for i, a, b in stances:
+        if b - a >= shortest:
             mid = a + (b - a) // 2
             first.append(float(grf_x[a:mid, i].sum() * dt))
             second.append(float(grf_x[mid:b, i].sum() * dt))
-    if not first:
-        return float("nan"), float("nan")
-    return float(np.median(first)), float(np.median(second))
+        else:
+            touches += float(grf_x[a:b, i].sum() * dt)
+    return float(np.median(first)), float(np.median(second)), touches / len(first)
 
 
 def stride_regularity(touchdowns: dict) -> tuple[float, float]:
@@ -339,7 +351,7 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         stance_work[j] = w
     total = sum(stance_work.values())
     cv, p2 = stride_regularity(m.touchdowns)
-    imp = ((float("nan"), float("nan")) if grf_x is None or len(grf_x) != len(t)
+    imp = ((float("nan"),) * 3 if grf_x is None or len(grf_x) != len(t)
            else stance_impulses(np.asarray(contact, bool)[sel], np.asarray(grf_x, float)[sel],
                                 dt, min_phase_s))
     return Biomechanics(
@@ -352,4 +364,5 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
                            for j, w in stance_work.items()},
         trunk_lean_deg=(float(np.degrees(np.mean(np.asarray(pitch, float)[sel])))
                         if pitch is not None and sel.any() else float("nan")),
-        stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1])
+        stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1],
+        touch_impulse_per_step_Ns=imp[2])
