@@ -1,0 +1,26 @@
+"""The jump corner's burst push, set by hand: one link of a tuning chain (set_by_hand, with
+what was set and why), from START's gains into OUT/p1.
+
+    python scripts/jump_push.py START.json OUT
+
+Used by scripts/tune_gains.sh (the committed chain), before stage jx3.
+"""
+import sys
+from pathlib import Path
+
+from cpgbiped.envs.search.controller_tuning import set_by_hand
+
+
+def main() -> None:
+    start, out = sys.argv[1], Path(sys.argv[2])
+    (out / "p1").mkdir(parents=True, exist_ok=True)
+    set_by_hand(start, {"synchronous.push": 0.45}, out / "p1" / "gains.json",
+                "the jump corner's knee torque per unit of burst drive 0.752 -> 0.45: on the "
+                "eight first tuning conditions (CPG seeds 1000-1007) the jump then rises "
+                "4.7-5.6 cm with 31-34 deg of ankle in stance, against 3.0-4.6 cm and 21-33 deg "
+                "(a hand sweep of 0.4-0.6; a push that saturates the knee throws the body "
+                "before the ankle has turned)")
+
+
+if __name__ == "__main__":
+    main()
