@@ -142,7 +142,8 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
         record_body.log_static(rs, world, _static_entities(rec.xml_path))
         record_body.log_poses(rs, world, model, t, pose)
         weight = float(model.body_mass.sum() * -model.opt.gravity[2])
-        record_body.log_forces(rs, world, t, _soles(model, pose), contact, rec.force, weight)
+        record_body.log_forces(rs, world, t, _soles(model, pose), contact, rec.force, weight,
+                               rec.grf_x if len(rec.grf_x) == len(t) else None)
         com = np.stack([rec.com_x, np.zeros_like(rec.com_x), rec.com_z], axis=1)
         record_body.log_com(rs, world, t, com)
     if metrics is not None:

@@ -7,8 +7,9 @@ Entities, under ``/<name>/world`` (world coordinates, metres; z up):
                               ellipsoids, cylinders and meshes with the model's sizes, poses and
                               colours (``geom_rgba``, or the material's)
   floor                       static: the model's planes as thin boxes
-  grf/<foot>                  an arrow per tick while that foot is in contact: the vertical
-                              ground reaction force, 0.5 m per body weight, from under the foot
+  grf/<foot>                  an arrow per tick while that foot is in contact: the ground
+                              reaction force (normal, and horizontal when the recording has
+                              it), 0.5 m per body weight, from under the foot
   com                         the centre of mass, a point per tick
 Nothing here is specific to the biped except the names of the feet, which the caller passes.
 Poses go out with one ``send_columns`` per body; the geometry once, as static data.
@@ -122,9 +123,11 @@ def log_poses(rs, root: str, model: mujoco.MjModel, t: np.ndarray, pose: np.ndar
 
 
 def log_forces(rs, root: str, t: np.ndarray, feet: dict, contact: np.ndarray,
-               force: np.ndarray, weight_n: float) -> None:
-    """Vertical ground reaction force arrows while each foot is in contact; feet maps a name to
-    its (T, 3) sole position; contact (T, k) bool and force (T, k) N in the same order."""
+               force: np.ndarray, weight_n: float, force_x: np.ndarray | None = None) -> None:
+    """Ground reaction force arrows while each foot is in contact, 0.5 m per body weight: the
+    normal force ``force`` (T, k; N) up and, when given, the horizontal force ``force_x`` (T, k;
+    N, > 0 forwards) along x, so that an arrow leaning back is a foot pushing the body back.
+    feet maps a name to its (T, 3) sole position; contact (T, k) bool, in the same order."""
     import rerun as rr
 
     for i, (foot, sole) in enumerate(feet.items()):
@@ -132,6 +135,8 @@ def log_forces(rs, root: str, t: np.ndarray, feet: dict, contact: np.ndarray,
         origins = sole[on]
         vectors = np.zeros_like(origins)
         vectors[:, 2] = 0.5 * force[on, i] / weight_n
+        if force_x is not None:
+            vectors[:, 0] = 0.5 * force_x[on, i] / weight_n
         cols = rr.Arrows3D.columns(origins=origins, vectors=vectors).partition(on.astype(np.int32))
         rs.send_columns(f"{root}/grf/{foot}", indexes=[rr.TimeColumn("sim_time", duration=t)],
                         columns=cols)
