@@ -131,12 +131,9 @@ def test_stance_impulses_split_each_stance_at_its_middle():
     assert touches == pytest.approx(2 * -300.0 * dt / 2)  # -6 N s over the 2 stances counted
 
 
-def test_the_run_brakes_then_propels_and_the_hop_pushes_backwards():
+def test_the_run_brakes_then_propels():
     """A gait moving forwards at a steady speed brakes in the first half of each stance and
-    propels in the second (Cavagna et al. 1976 for human running); the hop, which drifts
-    backwards, is braked while it lands and pushed backwards while it takes off (README, hop)."""
+    propels in the second (Cavagna et al. 1976 for human running). (The hop's opposite pattern,
+    a take-off pushing backwards, is a measurement the README reports, not an expectation.)"""
     run = validate(build("ml", "run"), "run", 8.0).summary()
     assert run["stance_impulse_first_half_Ns"] < 0 < run["stance_impulse_second_half_Ns"]
-    hop = validate(build("ml", "hop"), "hop", 8.0).summary()
-    assert hop["speed_mps"] < 0
-    assert hop["stance_impulse_first_half_Ns"] > 0 > hop["stance_impulse_second_half_Ns"]

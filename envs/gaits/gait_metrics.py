@@ -275,8 +275,8 @@ def stance_impulses(contact: np.ndarray, grf_x: np.ndarray, dt: float,
     """(first half, second half, touches): the median over the complete stances of both feet
     of the impulse of ``grf_x`` (T, 2; N) on that foot in the first and in the second half of
     the stance's ticks (N s), and the impulse of the brief touches left out (below), summed
-    over the window and divided by the number of stances counted (N s per step). A stance here is a run of raw ``contact`` (T, 2) with its gaps
-    shorter than ``min_phase_s`` closed, so that every tick that carries a force belongs to a
+    over the window and divided by the number of stances counted (N s per step). A stance
+    here is a run of raw ``contact`` (T, 2) with its gaps shorter than ``min_phase_s`` closed, so that every tick that carries a force belongs to a
     stance (a touchdown's first bounce too, which :func:`debounce` would drop, and with it the
     landing's braking); a stance cut by the window's ends is not counted, nor a brief touch
     shorter than half the 75th percentile of the stances' durations (a swinging foot's scuff,
@@ -351,9 +351,9 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         stance_work[j] = w
     total = sum(stance_work.values())
     cv, p2 = stride_regularity(m.touchdowns)
-    imp = ((float("nan"),) * 3 if grf_x is None or len(grf_x) != len(t)
-           else stance_impulses(np.asarray(contact, bool)[sel], np.asarray(grf_x, float)[sel],
-                                dt, min_phase_s))
+    imp = (stance_impulses(np.asarray(contact, bool)[sel], np.asarray(grf_x, float)[sel], dt,
+                           min_phase_s)
+           if grf_x is not None and len(grf_x) == len(t) else (float("nan"),) * 3)
     return Biomechanics(
         froude=v * v / (G * leg_length_m), stride_length_m=stride,
         relative_stride_length=stride / leg_length_m, positive_work_J=work,
