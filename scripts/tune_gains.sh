@@ -3,7 +3,7 @@
 # (envs/control/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
 # order, each started from the one before. Every run is deterministic (its seed, its tuning
 # conditions), so the chain ends with the committed parameters, bit for bit; the last line
-# checks it. About 205 minutes on 2 cores. Usage:
+# checks it. About 182 minutes on 2 cores. Usage:
 #     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
 # then `cp OUT/final/gains.json envs/control/gains.json` makes the result the controller's gains.
 set -euo pipefail
@@ -68,12 +68,6 @@ startup_end="$prev"
 python3 scripts/jump_push.py "$prev" "$OUT"
 prev="$OUT/p1/gains.json"
 stage jx3 --gait walk,jump --only 'synchronous.*' --guard walk --guard-gains "$startup_end" --conditions 1-8,21-24 --gens 30 --pop 16 --sigma 0.05 --seed 64
-# ... and once more over 20 conditions (the closed loop among them), the walk guarded against
-# jx3's gains (23 minutes). After jx3 the jump drifted back at 0.047-0.058 m/s over the 20 s
-# windows of 15 tuning conditions (the 0.05 allowed; one more fell); after jx4 at 0.007-0.036
-# in 17 of 20 (10 s windows; 2 fall, 1 drifts at 0.060). Committed as run from
-# envs/control/gains.json, jx3's (the same parameters).
-stage jx4 --gait walk,jump --only 'synchronous.*' --guard walk --guard-gains "$prev" --conditions 1-16,21-24 --gens 30 --pop 16 --sigma 0.05 --seed 65
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys
