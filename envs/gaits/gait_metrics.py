@@ -276,9 +276,9 @@ def stance_impulses(contact: np.ndarray, grf_x: np.ndarray, dt: float,
     of the impulse of ``grf_x`` (T, 2; N) on that foot in the first and in the second half of
     the stance's ticks (N s), and the impulse of the brief touches left out (below), summed
     over the window and divided by the number of stances counted (N s per step). A stance
-    here is a run of raw ``contact`` (T, 2) with its gaps shorter than ``min_phase_s`` closed, so that every tick that carries a force belongs to a
-    stance (a touchdown's first bounce too, which :func:`debounce` would drop, and with it the
-    landing's braking); a stance cut by the window's ends is not counted, nor a brief touch
+    here is a run of raw ``contact`` (T, 2) with its gaps shorter than ``min_phase_s``
+    closed, so that every tick that carries a force belongs to a stance (a touchdown's first
+    bounce too, which :func:`debounce` would drop, and with it the landing's braking); a stance cut by the window's ends is not counted, nor a brief touch
     shorter than half the 75th percentile of the stances' durations (a swinging foot's scuff,
     which carries no weight)."""
     n_min = max(1, int(round(min_phase_s / dt))) if dt > 0 else 1
