@@ -70,6 +70,7 @@ changes the search or its result.
 from __future__ import annotations
 
 import hashlib
+import sys
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -533,6 +534,11 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     t0 = time.perf_counter()
     problem = ControllerTuningProblem(settings, base, runner)
     x0 = values_of(base, problem.names)
+    outside = [f"{n} {v:g} not in [{a:g}, {b:g}]" for n, v, a, b
+               in zip(problem.names, x0, problem.xl, problem.xu) if not a <= v <= b]
+    if outside:  # a hand-set link of the chain may leave the box; the start stays a candidate
+        print("cpgbiped: warning: the search starts inside its box, from the nearest point: "
+              + "; ".join(outside), file=sys.stderr)
     algorithm = algorithm_for(settings, x0, problem.xl, problem.xu, rs.pop, rs.seed)
 
     def on_generation(gen, n):
