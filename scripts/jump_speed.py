@@ -3,8 +3,8 @@
 
     python scripts/jump_speed.py START.json OUT
 
-A measured candidate, not adopted (README, "Jump"): not in scripts/tune_gains.sh. The speed term c_v of
-the thigh target theta = theta0 + c_v v_com + c_d (x_com - x_sup) is searched in [0, 0.8]
+A measured candidate, not adopted (README, "Jump"): not in scripts/tune_gains.sh. The speed
+term c_v of the thigh target theta = theta0 + c_v v_com + c_d (x_com - x_sup) is searched in [0, 0.8]
 by every stage (a Raibert hopper's sign: the foot lands further ahead the faster the body
 moves). In the two-legged jump it works the other way round, measured: a smaller c_v (down to
 negative values) slows the jump's backward drift (a hand sweep on the tuning conditions,
@@ -28,7 +28,7 @@ def main() -> None:
     start, out = sys.argv[1], Path(sys.argv[2])
     (out / "v1").mkdir(parents=True, exist_ok=True)
     set_by_hand(start, {"synchronous.c_v": C_V}, out / "v1" / "gains.json",
-                "the jump corner's foot-placement speed term 0.51 -> -0.3, outside the tuning "
+                f"the jump corner's foot-placement speed term 0.51 -> {C_V}, outside the tuning "
                 "box [0, 0.8]: a Raibert hopper's sign does not carry over to the two-legged "
                 "jump (measured; why not analysed); " + SWEEP)
 
