@@ -68,6 +68,10 @@ startup_end="$prev"
 python3 scripts/jump_push.py "$prev" "$OUT"
 prev="$OUT/p1/gains.json"
 stage jx3 --gait walk,jump --only 'synchronous.*' --guard walk --guard-gains "$startup_end" --conditions 1-8,21-24 --gens 30 --pop 16 --sigma 0.05 --seed 64
+# The jump corner's foot-placement speed term set by hand below the search box (README, "Jump"):
+# a smaller c_v slows the jump's backward drift, the opposite of a Raibert hopper's sign.
+python3 scripts/jump_speed.py "$prev" "$OUT"
+prev="$OUT/v1/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

@@ -121,15 +121,16 @@ def test_sweep_cli_writes_its_json_and_picture(tmp_path):
 
 # -- issue 22's "done when", measured (README "Transitions"); strict xfails --------------------
 IN_FAMILY_SHORTFALL = {
-    ("walk", "run", 0.0): "falls at 11.2 s, 3.2 s after the change",
-    ("walk", "run", 2.0): "falls at 11.1 s, 1.1 s after the ramp ends",
-    ("run", "walk", 0.0): "falls at 10.4 s, 2.4 s after the change",
-    ("run", "walk", 2.0): "falls at 10.1 s, 0.1 s after the ramp ends",
-    ("jump", "hop", 0.0): "falls at 9.4 s, 1.4 s after the change",
-    ("jump", "hop", 2.0): "the jump named jump before, a hop after, no fall, but 5 CPG cycles "
-                          "after the change (4 asked)",
-    ("hop", "jump", 0.0): "no fall, but the body keeps hopping (named hop after the change)",
-    ("hop", "jump", 2.0): "falls at 20.0 s, 10 s after the ramp ends",
+    ("walk", "run", 0.0): "falls at 9.2 s, 1.2 s after the change",
+    ("walk", "run", 2.0): "a walk before, a run after, no fall, but 9 CPG cycles after the "
+                          "change (4 asked)",
+    ("run", "walk", 0.0): "falls at 10.1 s, 2.1 s after the change",
+    ("run", "walk", 2.0): "falls at 10.5 s, 0.5 s after the ramp ends",
+    ("jump", "hop", 0.0): "the jump is named hop in the 6 s before the change (its start-up); "
+                          "a hop after it, no fall",
+    ("jump", "hop", 2.0): "falls at 10.4 s, 0.4 s after the ramp ends",
+    ("hop", "jump", 0.0): "falls at 16.9 s, 8.9 s after the change",
+    ("hop", "jump", 2.0): "falls at 15.2 s, 5.2 s after the ramp ends",
 }
 
 
