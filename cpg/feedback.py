@@ -36,11 +36,12 @@ chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuok
   network's walk (and the load forms its run) into a skip (cpg/feedback_gains.json holds every
   candidate's numbers).
 Hopf (Tegotae, Owaki & Ishiguro 2013/2017: each extensor oscillator's phase is pushed by its
-leg's load). With the phase theta_i = atan2(y_i, x_i) (the burst, y > 0, is theta in (0, pi)):
+leg's load). With the phase theta_i = atan2(y_i, x_i) (the oscillator's stance half, y > 0,
+is theta in (0, pi); the body's burst, y above the preset's activation centre, lies inside it):
     dtheta_{2+l}/dt += K n_l cos(theta_{2+l})
   i.e. in the oscillator's own coordinates, with r = sqrt(x^2 + y^2),
     dx += -K n_l (x / r) y,    dy += K n_l (x / r) x.
-  A loaded leg slows in the second half of its burst (cos < 0) and is held there until it is
+  A loaded leg slows in the second half of its stance half (cos < 0) and is held there until it is
   unloaded; the form of Owaki's dphi/dt = omega - sigma N cos(phi) with the burst shifted by pi
   (his stance is phi in (pi, 2 pi)). K in rad/s per body weight.
 Matsuoka (Taga 1991: contact-gated joint angles into the neurons). Each ankle flexor neuron

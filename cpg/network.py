@@ -21,7 +21,15 @@ Kinds:
   activation 1 / (1 + exp(-v / 0.04)): the cell's burst (v > 0) is a = 1.
 - ``"hopf"``: four Hopf oscillators with stance/swing asymmetry (:mod:`cpg.hopf`) at a primary
   gait's phase lags. Time in seconds. Output y in [-sqrt(mu), sqrt(mu)]; activation
-  1 / (1 + exp(-y / 0.1)): the "stance" half of the cycle (y > 0) is the burst.
+  1 / (1 + exp(-(y - c) / 0.1)), the burst y > c. The centre c of each preset
+  (:data:`HOPF_CENTRES`, from the data file :data:`HOPF_ACTIVATION_FILE`) makes its cells
+  burst (activation > 1/2) for the same fraction of the cycle as the Morris-Lecar cells of
+  the same preset (:func:`burst_fraction`; ``scripts/calibrate_hopf_activation.py``): with
+  c = 0, the "stance" half y > 0, they burst for 0.42, 0.40, 0.45 and 0.39 of the walk's,
+  run's, jump's and hop's cycles against the Morris-Lecar cells' 0.30, 0.35, 0.38 and 0.41,
+  so the one controller, tuned on Morris-Lecar rhythms, got longer bursts from a Hopf walk
+  than from the walk it was tuned on. A parameter change (:func:`blend`, a schedule) moves
+  c with the other parameters.
 - ``"matsuoka"``: the calibrated 12-neuron two-leg network (:mod:`cpg.matsuoka`); its ankle
   neurons (left/right ankle flexor and extensor) are the four cells. Time in seconds. Output
   y = max(x, 0) >= 0 (about 0..4.7 with the calibrated tonic input r = 8); activation
@@ -32,7 +40,9 @@ Kinds:
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -60,6 +70,7 @@ KINDS = ("ml", "hopf", "matsuoka")
 ML_UNITS_PER_S = 12.3
 ML_V_HALF, ML_V_WIDTH = 0.0, 0.04  # activation map of a Morris-Lecar cell (voltage units)
 HOPF_WIDTH = 0.1  # activation map of a Hopf oscillator (units of y)
+HOPF_ACTIVATION_FILE = Path(__file__).with_name("hopf_activation.json")
 MATSUOKA_PEAK = 4.0  # usual peak output of a calibrated ankle neuron (r = 8)
 # Half-activation of a Matsuoka ankle neuron, as a fraction of that peak: at 0.6 the extensor
 # neurons' bursts (activation > 0.5) cover about a third of the cycle (0.34) and the flexors'
@@ -109,6 +120,13 @@ class Network:
     def activation(self, v: np.ndarray) -> np.ndarray:
         """Muscle activations in [0, 1] of raw outputs v (..., 4)."""
         raise NotImplementedError
+
+    def activation_along(self, v: np.ndarray, to: "Network | None",
+                         alpha: np.ndarray) -> np.ndarray:
+        """Activations of outputs v (T, 4) while the parameters move towards ``to``'s, alpha
+        (T,) of the way there at each sample: the activation map moves with them where it
+        is a parameter of the network (Hopf); otherwise it is :meth:`activation`."""
+        return self.activation(v)
 
     def params(self) -> dict:
         """The parameters as plain numbers (for reports and JSON)."""
@@ -205,6 +223,15 @@ def _period_cached(key, net: Network) -> float:
     return float(r.period)
 
 
+def burst_fraction(net: Network, cycles: float = 20.0) -> np.ndarray:
+    """(4,) fraction of the cycle that each cell LF, RF, LE, RE bursts (activation > 1/2), on
+    the network alone from its initial state, after its settling time, over ``cycles`` of its
+    periods."""
+    t_end = net.settle + cycles * net.period()
+    out = net.outputs(t_end, t_record=net.settle)
+    return (net.activation(out.v) > 0.5).mean(axis=0)
+
+
 def _label(net: Network) -> str:
     return f"{net.kind} {net.preset}" if net.preset else net.kind
 
@@ -269,10 +296,19 @@ class HopfPreset:
 # body for the same cadences: 13.113, 8.868, 11.985 and 7.918 model units, i.e. 1.066, 0.721,
 # 0.974 and 0.644 s. The period formula below is the large-a limit; it holds within 5% for
 # beta >= 0.35 (at beta 0.3 the walk's measured period is 8% shorter), which sets the betas
-# even though the cells' activations then exceed one half (the controller's stance threshold)
-# for longer than the Morris-Lecar cells': 0.42, 0.40, 0.45, 0.40 of the cycle against 0.30,
-# 0.35, 0.38, 0.42 (walk, run, jump, hop; measured from the presets' states over 20 cycles).
+# even though y > 0 then lasts longer than the Morris-Lecar cells' bursts; the activation's
+# centre (HOPF_CENTRES) gives back the Morris-Lecar burst fractions, so that the two networks
+# ask the body for the same cadences and the same burst lengths.
 ML_TABLE2_PERIODS = {"walk": 13.113, "run": 8.868, "jump": 11.985, "hop": 7.918}
+
+
+def _hopf_centres() -> dict[str, float]:
+    data = json.loads(HOPF_ACTIVATION_FILE.read_text())
+    return {g: float(row["centre"]) for g, row in data["presets"].items()}
+
+
+# Activation centre c of each Hopf preset (units of y); provenance in the data file.
+HOPF_CENTRES = _hopf_centres()
 
 
 def _hopf(gait, beta):
@@ -295,15 +331,18 @@ class HopfNetwork(Network):
     dt = 1e-3
     settle = 5.0
 
-    def __init__(self, lags, p: hopf_mod.HopfParams, y0: np.ndarray, preset: str | None = None):
+    def __init__(self, lags, p: hopf_mod.HopfParams, y0: np.ndarray, preset: str | None = None,
+                 act_centre: float = 0.0):
         lags = np.asarray(lags, dtype=float)
         if lags.shape != (4,) or not np.all(np.isfinite(lags)):
             raise InputError("Hopf phase lags must be four finite numbers (cycles)")
         y0 = np.asarray(y0, dtype=float)
         if y0.shape != (8,) or not np.all(np.isfinite(y0)):
             raise InputError("a Hopf initial state is 8 finite numbers [x x4, y x4]")
+        if not np.isfinite(act_centre):
+            raise InputError("a Hopf activation centre must be finite")
         super().__init__(preset, y0)
-        self.lags, self.p = lags, p
+        self.lags, self.p, self.act_centre = lags, p, float(act_centre)
 
     def _integrate(self, y0, t_end, t_record, record_every, to, schedule):
         kw = {} if to is None else dict(to=(to.lags, to.p), knots=(schedule.t, schedule.alpha))
@@ -314,7 +353,14 @@ class HopfNetwork(Network):
         return hopf_mod.random_states(4, 1, seed)[0]
 
     def activation(self, v):
-        return _sigmoid(np.asarray(v, dtype=float) / HOPF_WIDTH)
+        return _sigmoid((np.asarray(v, dtype=float) - self.act_centre) / HOPF_WIDTH)
+
+    def activation_along(self, v, to, alpha):
+        if to is None or to.act_centre == self.act_centre:
+            return self.activation(v)
+        c = self.act_centre + np.asarray(alpha, dtype=float)[:, None] * (to.act_centre
+                                                                          - self.act_centre)
+        return _sigmoid((np.asarray(v, dtype=float) - c) / HOPF_WIDTH)
 
     def loop_spec(self):
         from .feedback import KIND_HOPF
@@ -324,12 +370,12 @@ class HopfNetwork(Network):
                 "P": np.concatenate([[p.mu, p.alpha, p.omega_st, p.omega_sw, p.a, p.k,
                                       float(p.normalised)], np.cos(th).ravel(),
                                      np.sin(th).ravel()]),
-                "act_centre": 0.0, "act_width": HOPF_WIDTH}
+                "act_centre": self.act_centre, "act_width": HOPF_WIDTH}
 
     def params(self):
         return {"lags": self.lags.tolist(), "beta": self.p.beta, "omega_sw": self.p.omega_sw,
                 "mu": self.p.mu, "alpha": self.p.alpha, "a": self.p.a, "k": self.p.k,
-                "normalised": self.p.normalised}
+                "normalised": self.p.normalised, "act_centre": self.act_centre}
 
 
 # ----------------------------------------------------------------------------- Matsuoka
@@ -423,7 +469,8 @@ def build(kind: str = "ml", preset: str = "walk", *, weights=None, i_app: float 
         # The Hopf network has no published initial state: a fixed one on the unit circle at
         # the preset's lags, perturbed, so that the lock is reached by the coupling.
         ang = -2 * np.pi * np.asarray(hp.lags) + np.array([0.0, 0.3, -0.2, 0.1])
-        net = HopfNetwork(hp.lags, hp.params, np.concatenate([np.cos(ang), np.sin(ang)]), preset)
+        net = HopfNetwork(hp.lags, hp.params, np.concatenate([np.cos(ang), np.sin(ang)]), preset,
+                          HOPF_CENTRES[preset])
     else:
         p = mt.CALIBRATED
         net = MatsuokaNetwork(p, mt.initial_state(p)[0], seed=0 if seed is None else int(seed),
@@ -445,5 +492,6 @@ def blend(a: Network, b: Network, alpha: float) -> Network:
     if isinstance(a, HopfNetwork):
         p = replace(a.p, beta=a.p.beta + alpha * (b.p.beta - a.p.beta),
                     omega_sw=a.p.omega_sw + alpha * (b.p.omega_sw - a.p.omega_sw))
-        return HopfNetwork(a.lags + alpha * (b.lags - a.lags), p, a.y0, None)
+        return HopfNetwork(a.lags + alpha * (b.lags - a.lags), p, a.y0, None,
+                           a.act_centre + alpha * (b.act_centre - a.act_centre))
     raise InputError(f"the {a.kind} network has no parameter blend")

@@ -7,7 +7,7 @@ from cpgbiped.cpg.errors import InputError, NotOscillatingError
 from cpgbiped.cpg.gaits import classify
 from cpgbiped.cpg.integrate import Schedule, simulate_ml
 from cpgbiped.cpg.network import (HOPF_PRESETS, KINDS, ML_UNITS_PER_S, PRESETS, blend, build,
-                         ml_weights)
+                         burst_fraction, ml_weights)
 from cpgbiped.cpg.reproduce import run_preset
 
 
@@ -56,6 +56,36 @@ def test_hopf_presets_ask_for_the_morris_lecar_cadences():
     gait (Table 2 weights at the one ML time unit), measured on both networks."""
     for g in HOPF_PRESETS:
         assert build("hopf", g).period_s() == pytest.approx(build("ml", g).period_s(), rel=0.05)
+
+
+@pytest.mark.parametrize("gait", ml.PRIMARY_GAITS)
+def test_hopf_presets_burst_as_long_as_the_morris_lecar_cells(gait):
+    """cpg/hopf_activation.json's centre gives each Hopf preset the Morris-Lecar preset's burst
+    fraction (activation > 1/2, mean over the four cells), recomputed here from both networks
+    alone; with the centre at 0 (y > 0, the oscillator's "stance" half) the Hopf bursts are
+    longer by more than the tolerance in the walk, run and jump."""
+    f_ml = burst_fraction(build("ml", gait)).mean()
+    net = build("hopf", gait)
+    assert burst_fraction(net).mean() == pytest.approx(f_ml, abs=0.01)
+    at_zero = net.with_state(net.y0)
+    at_zero.act_centre = 0.0
+    if gait != "hop":
+        assert burst_fraction(at_zero).mean() > f_ml + 0.03
+
+
+def test_hopf_activation_centre_moves_with_a_parameter_change():
+    """Along a change from the walk to the run the activation's centre moves as the other
+    parameters do: the start's map at alpha 0, the target's at 1, halfway at 1/2 (blend)."""
+    a, b = build("hopf", "walk"), build("hopf", "run")
+    assert a.act_centre != b.act_centre
+    v = np.linspace(-1, 1, 12).reshape(3, 4)
+    got = a.activation_along(v, b, np.array([0.0, 0.5, 1.0]))
+    assert np.allclose(got[0], a.activation(v[0]))
+    assert np.allclose(got[2], b.activation(v[2]))
+    assert np.allclose(got[1], blend(a, b, 0.5).activation(v[1]))
+    assert np.allclose(a.activation(np.full(4, a.act_centre)), 0.5)
+    m = build("ml", "walk")  # the Morris-Lecar map is no parameter of the preset
+    assert np.array_equal(m.activation_along(v, build("ml", "run"), np.ones(3)), m.activation(v))
 
 
 def test_hopf_compiled_equals_numpy_reference():

@@ -28,7 +28,8 @@ def test_a_wheel_installs_one_top_level_name_with_its_data(tmp_path):
     top = {n.split("/")[0] for n in names if ".dist-info/" not in n}
     assert top == {"cpgbiped"}
     for f in ("cpgbiped/envs/control/gains.json", "cpgbiped/envs/control/gains_root.json",
-              "cpgbiped/cpg/feedback_gains.json", "cpgbiped/models/biped/biped.xml",
+              "cpgbiped/cpg/feedback_gains.json", "cpgbiped/cpg/hopf_activation.json",
+              "cpgbiped/models/biped/biped.xml",
               "cpgbiped/models/biped/scene.xml", "cpgbiped/envs/cli/main.py"):
         assert f in names, f
     entry = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("entry_points.txt")))

@@ -310,7 +310,12 @@ def cpg_schedule(network: Network, seconds: float, *, to: Network | None = None,
         raise InputError(f"the {network.kind} network diverges (its state leaves the cell's "
                          f"range): it cannot drive the body")
     v = np.ascontiguousarray(out.v, dtype=float)
-    return CPGSchedule(v, np.ascontiguousarray(network.activation(v)), network.dt * every / u)
+    dt_s = network.dt * every / u
+    if to is None or change is None:
+        a = network.activation(v)
+    else:  # the activation map moves with the parameters where it is one of them (Hopf)
+        a = network.activation_along(v, to, change.at(np.arange(len(v)) * dt_s))
+    return CPGSchedule(v, np.ascontiguousarray(a), dt_s)
 
 
 def params_array(p: ControlParams) -> np.ndarray:
