@@ -72,6 +72,10 @@ stage jx3 --gait walk,jump --only 'synchronous.*' --guard walk --guard-gains "$s
 # a smaller c_v slows the jump's backward drift, the opposite of a Raibert hopper's sign.
 python3 scripts/jump_speed.py "$prev" "$OUT"
 prev="$OUT/v1/gains.json"
+# The lift abort (README, "Start-up deadlock"): a rule of the controller's swing latch, switched
+# on by hand after a measurement on the tuning conditions.
+python3 scripts/lift_abort.py "$prev" "$OUT"
+prev="$OUT/la/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

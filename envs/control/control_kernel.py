@@ -26,7 +26,7 @@ from cpgbiped.cpg.feedback import outputs as fb_outputs
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in
 # CORNER order: (sigma, kappa) = (0, 0), (0, 1), (1, 0), (1, 1).
-SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold")
+SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
@@ -34,6 +34,7 @@ BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "k
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0}
+ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0}
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -134,6 +135,7 @@ def control(t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, ix, u, v_
 def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     """Write the 8 controls for time t_s (s) into u, from the CPG's activations a (4,)."""
     ankle_gain, e_on, w_flex, w_cross, contact_hold = P[0], P[1], P[2], P[3], P[4]
+    lift_abort = P[5] > 0.5
     # Per leg i (0 left, 1 right): flexor f = a[i], extensor e = a[2 + i].
     e = np.empty(2)
     f = np.empty(2)
@@ -223,7 +225,10 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     # together, by their push. It swings until its foot lands after having left the ground,
     # and the landing counts when the drive is over, or the foot is x_clear ahead of the hip
     # (where the swing stops tucking; a scuff behind that in mid-swing is not a landing), or
-    # the other foot is off the ground.
+    # the other foot is off the ground. With lift_abort, a lift whose foot has not yet left
+    # the ground ends when the other foot leaves it first: the leg would otherwise lift away
+    # what has become the only support (a deadlock: a swinging leg standing on the ground,
+    # found in the CPG's start-up transients, README "Start-up deadlock").
     stance_cmd = np.empty(2, dtype=np.bool_)
     for i in range(2):
         stance_cmd[i] = e[i] >= e_on
@@ -250,6 +255,8 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                 S[S_AIRBORNE + i] = 1.0
             elif S[S_AIRBORNE + i] > 0.5 and (g[i] < 0.5 or foot_x[i] > hip_x + x_clear
                                                or not ground[j]):
+                S[S_SWUNG + i] = 0.0
+            elif lift_abort and S[S_AIRBORNE + i] < 0.5 and not ground[j]:
                 S[S_SWUNG + i] = 0.0
         if g[i] < 0.5:  # one lift per swing drive
             S[S_SWING_DONE + i] = 0.0

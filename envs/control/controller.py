@@ -41,7 +41,9 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    alternate (sigma < SIGMA_LIFT = 0.4: in a synchronous rhythm no leg lifts on its own, both
    leave the ground together by their push), once per swing drive - until its foot lands
    again after having left the ground, when the drive is over or x_clear ahead of the hip (a
-   scuff behind that is not a landing) or with the other foot off the ground. Each leg is in
+   scuff behind that is not a landing) or with the other foot off the ground; with
+   ``lift_abort`` (shared) a lift whose foot is still on the ground ends when the other foot
+   leaves the ground first (the leg is the only support then). Each leg is in
    one mode:
    - lift: swinging, its foot still on the ground;
    - air: swinging, or any foot off the ground (it prepares to land);
@@ -160,6 +162,8 @@ class ControlParams:
     w_flex: float  # swing drive from the leg's own flexor
     w_cross: float  # swing drive from the other leg's extensor (crossed extension)
     contact_hold: float  # s: ground contact held this long after the last touch
+    lift_abort: float  # > 0.5: a lift ends while its foot is still down if the other foot
+    # leaves the ground first (0 reproduces the controller before it)
     alternating: Corner  # sigma = 0, kappa = 0 (the walk's rhythm)
     alternating_coactive: Corner  # sigma = 0, kappa = 1 (the run's)
     synchronous: Corner  # sigma = 1, kappa = 0 (the two-legged jump's)
@@ -212,7 +216,7 @@ def params_from_dict(d: dict, what: str = "gains") -> ControlParams:
         return corners
 
     try:
-        shared, corners = d["shared"], complete(d["corners"])
+        shared, corners = {**kernel.ADDED_NEUTRAL_SHARED, **d["shared"]}, complete(d["corners"])
         if set(shared) != set(kernel.SHARED):
             raise KeyError("names")
         vals = [float(shared[n]) for n in kernel.SHARED] + [
@@ -249,7 +253,8 @@ def gains_schema() -> dict:
 
     def block(names):
         return {"type": "object", "additionalProperties": False,
-                "required": [n for n in names if n not in kernel.ADDED_NEUTRAL],
+                "required": [n for n in names if n not in kernel.ADDED_NEUTRAL
+                             and n not in kernel.ADDED_NEUTRAL_SHARED],
                 "properties": {n: num for n in names}}
 
     corners = {"type": "object", "required": list(kernel.CORNERS), "additionalProperties": False,

@@ -100,10 +100,10 @@ CORNER_RANGES = dict(
     knee_hold=(0.0, 1.0), land_yield=(0.0, 1.0))
 # Gains added after the stages of scripts/tune_gains.sh that search every gain were run: a
 # search takes them only when --only names them, so that those stages reproduce.
-OPT_IN = ("land_yield",)
+OPT_IN = ("land_yield", "lift_abort")
 # ... and of the shared parameters.
 SHARED_RANGES = dict(ankle_gain=(0.05, 0.35), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
-                     w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06))
+                     w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06), lift_abort=(0.0, 1.0))
 if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHARED:
     raise ImportError("the tuning box and envs.control_kernel's parameter layout disagree")
 
@@ -503,6 +503,9 @@ def params_sha256(p: ControlParams) -> str:
         for name, neutral in kernel.ADDED_NEUTRAL.items():  # out: older files hash as before
             if gains[name] == neutral:
                 del gains[name]
+    for name, neutral in kernel.ADDED_NEUTRAL_SHARED.items():
+        if d["shared"][name] == neutral:
+            del d["shared"][name]
     text = json.dumps(d, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
