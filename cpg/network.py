@@ -25,8 +25,8 @@ Kinds:
   (:data:`HOPF_CENTRES`, from the data file :data:`HOPF_ACTIVATION_FILE`) makes its cells
   burst (activation > 1/2) for the same fraction of the cycle as the Morris-Lecar cells of
   the same preset (:func:`burst_fraction`; ``scripts/calibrate_hopf_activation.py``): with
-  c = 0, the "stance" half y > 0, they burst for 0.42, 0.40, 0.45 and 0.39 of the walk's,
-  run's, jump's and hop's cycles against the Morris-Lecar cells' 0.30, 0.35, 0.38 and 0.41,
+  c = 0, the "stance" half y > 0, they burst for 0.42, 0.40, 0.45 and 0.40 of the walk's,
+  run's, jump's and hop's cycles against the Morris-Lecar cells' 0.30, 0.35, 0.38 and 0.42,
   so the one controller, tuned on Morris-Lecar rhythms, got longer bursts from a Hopf walk
   than from the walk it was tuned on. A parameter change (:func:`blend`, a schedule) moves
   c with the other parameters.
@@ -291,7 +291,7 @@ class HopfPreset:
 
 # The primary gaits of the Hopf network. The lags are those of the gait table (every cell in
 # the phase the Morris-Lecar preset of that gait reaches); beta is the fraction of the cycle in
-# the "stance" half, y > 0 (the burst). The cycle time is the Morris-Lecar preset's period
+# the "stance" half, y > 0 (the body's burst is y > c, the activation's centre, inside it). The cycle time is the Morris-Lecar preset's period
 # (Table 2 weights, `cpgbiped reproduce`) at ML_UNITS_PER_S, so that the two networks ask the
 # body for the same cadences: 13.113, 8.868, 11.985 and 7.918 model units, i.e. 1.066, 0.721,
 # 0.974 and 0.644 s. The period formula below is the large-a limit; it holds within 5% for

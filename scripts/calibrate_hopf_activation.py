@@ -1,11 +1,12 @@
 """Calibrate the Hopf presets' activation centres (cpg/hopf_activation.json).
 
-Rule (fixed before any rollout of the body was scored): each Hopf preset's cells burst
-(activation 1 / (1 + exp(-(y - c) / 0.1)) above one half, i.e. y > c) for the same mean
-fraction of the cycle as the Morris-Lecar preset of the same gait, from its Table 3 state
-(cpg.network.burst_fraction, 20 cycles after the settling time): c is the quantile of the
-Hopf outputs y, pooled over the four cells and 20 cycles, above which that fraction lies.
-A computation on the networks alone; no rollout of the body enters it.
+Rule (a computation on the networks alone; no rollout of the body enters it; chosen after a
+hand sweep of c on the Hopf walk's matrix row, README "Matrices"): each Hopf preset's cells
+burst (activation 1 / (1 + exp(-(y - c) / 0.1)) above one half, i.e. y > c) for the same
+mean fraction of the cycle as the Morris-Lecar preset of the same gait from its Table 3 state
+(cpg.network.burst_fraction, 20 cycles after the settling time); the Hopf preset runs from
+its built-in initial state, and c is the quantile of its outputs y, pooled over the four
+cells and 20 cycles, above which that fraction lies.
 
     python3 scripts/calibrate_hopf_activation.py [--out cpg/hopf_activation.json]
 """
@@ -45,9 +46,9 @@ def main() -> None:
         print(g, row)
     write_json(a.out, {
         "format": "cpgbiped.hopf_activation/1",
-        "rule": "each Hopf preset's cells burst (y > centre) for the Morris-Lecar preset's mean "
-                "burst fraction (activation > 1/2), 20 cycles from its Table 3 state; "
-                "networks alone, no body",
+        "rule": "each Hopf preset's cells burst (y > centre) for the mean burst fraction "
+                "(activation > 1/2) of the Morris-Lecar preset from its Table 3 state, both over "
+                "20 cycles; networks alone, no body",
         "command": "python3 scripts/calibrate_hopf_activation.py",
         "presets": presets})
 

@@ -260,3 +260,53 @@ def test_startup_gains_round_trip_and_refuse_bad_input():
     bad = {**d, "startup": {"tau_s": 1.0, "corners": {"alternating": d["corners"]["alternating"]}}}
     with pytest.raises(InputError, match="not a complete set"):
         params_from_dict(bad)
+
+
+def _longest_lift_on_the_only_foot(rec) -> float:
+    """Longest stretch (s) in which a leg is in its lift mode (swinging, its foot down) while
+    the other leg is in the air with its foot off the ground."""
+    best = 0.0
+    for i in range(2):
+        j = 1 - i
+        mask = ((rec.modes[:, i] == K.MODE_LIFT) & (rec.modes[:, j] == K.MODE_AIR)
+                & (rec.contact[:, j] < 0.5))
+        run = 0
+        for m in mask:
+            run = run + 1 if m else 0
+            best = max(best, run * rec.dt)
+    return best
+
+
+def test_lift_abort_ends_a_lift_that_the_other_foot_leaves_alone():
+    """lift_abort (README "Start-up deadlock"): from the random CPG state of seed 7 the jump
+    network lifts the left leg while the right stands, then the right extensor pushes the right
+    foot off before the left foot has left the ground. Without the rule the left leg stays in
+    its lift mode on the ground, carrying the body, for more than 0.2 s, and the body falls in
+    the first 2 s (measured: 0.32 s, fall at 1.1 s); with it such a stretch lasts no longer
+    than the contact hold (the other foot counts as down that long after it leaves) plus a
+    control tick, and the body is still up at 3 s."""
+    from dataclasses import replace
+
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    assert CONTROL.lift_abort > 0.5  # the committed gains have it on
+    net = build("ml", "jump", seed=7)
+    off = rollout(net, 3.0, replace(CONTROL, lift_abort=0.0), poses=False)
+    on = rollout(net, 3.0, CONTROL, poses=False)
+    assert _longest_lift_on_the_only_foot(off) > 0.2
+    assert off.fell_at is not None and off.fell_at < 2.0
+    assert _longest_lift_on_the_only_foot(on) <= CONTROL.contact_hold + 2 * on.dt
+    assert on.fell_at is None
+
+
+def test_the_schedule_moves_the_hopf_activation_with_the_parameters():
+    """Through a Hopf walk -> run step at 1 s the schedule's activations follow the walk's
+    activation map before the step and the run's after it (their centres differ)."""
+    from cpgbiped.cpg.integrate import Schedule
+
+    walk, run = build("hopf", "walk"), build("hopf", "run")
+    s = cpg_schedule(walk, 2.0, to=run, change=Schedule.change(1.0))
+    before, after = s.t_s < 0.99, s.t_s > 1.01
+    assert np.allclose(s.a[before], walk.activation(s.v[before]))
+    assert np.allclose(s.a[after], run.activation(s.v[after]))
+    assert not np.allclose(s.a[after], walk.activation(s.v[after]))

@@ -106,7 +106,7 @@ def test_an_unloaded_leg_silences_its_morris_lecar_extensor_under_load_feedback(
     assert act(closed).max() < 0.5 < 0.9 < act(opened).max()
 
 
-def test_tegotae_holds_a_loaded_hopf_leg_in_its_burst():
+def test_tegotae_holds_a_loaded_hopf_leg_in_its_stance_half():
     """dtheta/dt += K n cos(theta): with K n above the burst's angular speed (omega_st = 8.4
     rad/s for the walk) the loaded left extensor stops in the second half of its oscillator's
     stance half (y > 0, theta in (0, pi)) instead of cycling through y = -1. (Whether the body

@@ -1221,7 +1221,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "that --gait and --search select; a name may be one corner's "
                          "(synchronous.theta0) or all of it (synchronous.*), so that "
                          "--gait walk,jump --only 'synchronous.*' searches the jump's corner "
-                         "scored on both gaits; land_yield is searched only when named here")
+                         "scored on both gaits; land_yield and lift_abort are searched only when "
+                         "named here")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
                     help="gains file to start from (default: the controller's, envs/control/gains.json)")
     sp.add_argument("--guard", default="", metavar="GAITS",

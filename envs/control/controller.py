@@ -12,7 +12,8 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    (``loop``, :mod:`cpg.feedback`) it is stepped one tick at a time with the body's sensors;
    either way t_model = units_per_s * t_s, with
    the network's fixed time unit (:mod:`cpg.network`). The schedule holds the raw outputs v
-   and the activations a = network.activation(v) in [0, 1] of the cells LF, RF, LE, RE.
+   and the activations a = network.activation(v) in [0, 1] of the cells LF, RF, LE, RE
+   (network.activation_along through a parameter change, whose activation map may move).
    Per leg i (j the other leg): flexor f_i = a_iF, extensor e_i = a_iE,
    - swing drive     g_i = (1 - e_i) clip(w_flex f_i + w_cross e_j + swing_rest, 0, 1)
      (the leg's own flexor burst, or the other leg's extensor burst - a crossed extension -
@@ -32,8 +33,8 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
      p = (1-sigma)(1-kappa) p_alternating + (1-sigma) kappa p_alternating_coactive
          + sigma (1-kappa) p_synchronous + sigma kappa p_synchronous_coactive.
    A rhythm between the corners (a transition, a secondary gait, other weights) gets gains
-   between theirs. The ankle gain, the swing wiring (e_on, w_flex, w_cross) and contact_hold
-   are shared by all. Nothing depends on a name.
+   between theirs. The ankle gain, the swing wiring (e_on, w_flex, w_cross), contact_hold and
+   lift_abort are shared by all. Nothing depends on a name.
 2. Contacts and modes. A foot is on the ground while its contact force exceeds 1 N or did
    within the last ``contact_hold`` s. A leg *swings* from the moment its swing drive lifts
    it - g_i > 0.5 while it stands, the other leg stands with its stance command and no swing

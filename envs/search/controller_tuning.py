@@ -6,7 +6,8 @@ one corner (walk: alternating, run: alternating and co-active, jump: synchronous
 synchronous and co-active; measured in tests/test_controller.py). A run scores the gaits it
 names (``--gait walk``, ``--gait jump,hop``, ``--gait all``) and searches (``--search``) their
 corners, in the box :data:`CORNER_RANGES`, or the shared parameters (:data:`SHARED_RANGES`:
-ankle gain, swing wiring, contact hold), which every gait uses, or both; everything else stays
+ankle gain, swing wiring, contact hold; the lift abort only when named), which every gait
+uses, or both; everything else stays
 as in the starting gains file. Shared parameters are best searched with every gait scored
 (``--gait all --search shared``): a walk tuned alone once turned the crossed-extension swing
 drive down to 0.1, and the run, which swings on it, could no longer lift a leg.
