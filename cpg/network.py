@@ -223,13 +223,16 @@ def _period_cached(key, net: Network) -> float:
     return float(r.period)
 
 
+def settled_outputs(net: Network, cycles: float = 20.0) -> np.ndarray:
+    """(T, 4) raw outputs of the network alone from its initial state, after its settling
+    time, over ``cycles`` of its periods."""
+    return net.outputs(net.settle + cycles * net.period(), t_record=net.settle).v
+
+
 def burst_fraction(net: Network, cycles: float = 20.0) -> np.ndarray:
-    """(4,) fraction of the cycle that each cell LF, RF, LE, RE bursts (activation > 1/2), on
-    the network alone from its initial state, after its settling time, over ``cycles`` of its
-    periods."""
-    t_end = net.settle + cycles * net.period()
-    out = net.outputs(t_end, t_record=net.settle)
-    return (net.activation(out.v) > 0.5).mean(axis=0)
+    """(4,) fraction of the cycle that each cell LF, RF, LE, RE bursts (activation > 1/2), over
+    :func:`settled_outputs`."""
+    return (net.activation(settled_outputs(net, cycles)) > 0.5).mean(axis=0)
 
 
 def _label(net: Network) -> str:
@@ -352,15 +355,15 @@ class HopfNetwork(Network):
     def random_state(self, seed):
         return hopf_mod.random_states(4, 1, seed)[0]
 
-    def activation(self, v):
-        return _sigmoid((np.asarray(v, dtype=float) - self.act_centre) / HOPF_WIDTH)
+    def activation(self, v, centre=None):
+        c = self.act_centre if centre is None else centre
+        return _sigmoid((np.asarray(v, dtype=float) - c) / HOPF_WIDTH)
 
     def activation_along(self, v, to, alpha):
-        if to is None or to.act_centre == self.act_centre:
+        if to is None:
             return self.activation(v)
-        c = self.act_centre + np.asarray(alpha, dtype=float)[:, None] * (to.act_centre
-                                                                          - self.act_centre)
-        return _sigmoid((np.asarray(v, dtype=float) - c) / HOPF_WIDTH)
+        alpha = np.asarray(alpha, dtype=float)[:, None]
+        return self.activation(v, self.act_centre + alpha * (to.act_centre - self.act_centre))
 
     def loop_spec(self):
         from .feedback import KIND_HOPF

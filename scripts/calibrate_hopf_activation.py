@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from cpgbiped.cpg.io import write_json
-from cpgbiped.cpg.network import HOPF_ACTIVATION_FILE, build, burst_fraction
+from cpgbiped.cpg.network import HOPF_ACTIVATION_FILE, build, burst_fraction, settled_outputs
 
 GAITS = ("walk", "run", "jump", "hop")
 CYCLES = 20.0
@@ -28,9 +28,7 @@ def calibrate() -> dict:
     presets = {}
     for gait in GAITS:
         f_ml = float(burst_fraction(build("ml", gait), CYCLES).mean())
-        hopf = build("hopf", gait)
-        out = hopf.outputs(hopf.settle + CYCLES * hopf.period(), t_record=hopf.settle)
-        y = np.asarray(out.v, dtype=float)
+        y = np.asarray(settled_outputs(build("hopf", gait), CYCLES), dtype=float)
         centre = float(np.quantile(y.ravel(), 1.0 - f_ml))
         presets[gait] = {"centre": round(centre, 4), "ml_burst_fraction": round(f_ml, 4),
                          "hopf_burst_fraction_at_zero": round(float((y > 0).mean()), 4)}
