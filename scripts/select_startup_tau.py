@@ -12,6 +12,9 @@ fall is worse than a miss); the highest score wins, the smaller tau_s on a tie. 
 
     python scripts/select_startup_tau.py --live out/tune_chain/j2/gains.json \\
         --startup-from out/tune_chain/w4/gains.json --out envs/control/startup_selection.json
+
+Without --startup-from, the start-up corners are --live's own (gains that already have start-up
+gains: tau_s re-chosen after later links moved the corners, the end of scripts/tune_gains.sh).
 """
 import argparse
 import json
@@ -29,10 +32,21 @@ WALK_SEEDS = range(2000, 2100)
 JUMP_SEEDS = range(2000, 2050)
 
 
+def own_startup_corners(live: str, out: Path) -> str:
+    """A gains file (at ``out``) whose corners are ``live``'s start-up corners."""
+    d = json.loads(Path(live).read_text())
+    if "startup" not in d:
+        sys.exit(f"select_startup_tau: {live} has no start-up gains; give --startup-from")
+    d["corners"] = d["startup"]["corners"]
+    out.write_text(json.dumps(d))
+    return str(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--live", required=True, help="gains whose corners the body runs on")
-    ap.add_argument("--startup-from", required=True, help="gains whose corners start it")
+    ap.add_argument("--startup-from", help="gains whose corners start it (default: --live's "
+                    "own start-up corners)")
     ap.add_argument("--out", required=True)
     ap.add_argument("--candidates", default=",".join(map(str, CANDIDATES)))
     a = ap.parse_args()
@@ -40,9 +54,10 @@ def main() -> None:
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp, ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
+        startup_from = a.startup_from or own_startup_corners(a.live, Path(tmp) / "startup.json")
         for tau in (float(x) for x in a.candidates.split(",")):
             g = str(Path(tmp) / f"gains_{tau:g}.json")
-            set_startup(a.live, a.startup_from, tau, g, "candidate")
+            set_startup(a.live, startup_from, tau, g, "candidate")
             jobs = [("walk", s, g) for s in WALK_SEEDS] + [("jump", s, g) for s in JUMP_SEEDS]
             res = list(ex.map(one, jobs))
             walk = [r for r in res if r[0] == "walk"]

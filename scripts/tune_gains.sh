@@ -76,6 +76,21 @@ prev="$OUT/v1/gains.json"
 # on by hand after a measurement on the tuning conditions.
 python3 scripts/lift_abort.py "$prev" "$OUT"
 prev="$OUT/la/gains.json"
+# tau_s re-chosen at the chain's end (README, "Start-up gains"): the links after the first choice
+# moved the corners it hands over to; the same rule, the same start-up corners (w4's).
+python3 scripts/select_startup_tau.py --live "$prev" --out "$OUT/startup_selection_end.json"
+python3 - "$OUT" "$prev" "$walk_end" <<'PY'
+import json, sys
+from cpgbiped.envs.search.controller_tuning import set_startup
+out, prev, walk_end = sys.argv[1:4]
+tau = json.load(open(f"{out}/startup_selection_end.json"))["tau_s"]
+set_startup(prev, walk_end, tau, f"{out}/s2/gains.json",
+            "tau_s re-chosen after the jump's push, its speed term and the lift abort moved the "
+            "corners; the same rule and start-up corners (w4) as the first choice, by "
+            "scripts/select_startup_tau.py on CPG seeds 2000-2099 "
+            "(envs/control/startup_selection_end.json)")
+PY
+prev="$OUT/s2/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys
