@@ -120,30 +120,40 @@ def test_sweep_cli_writes_its_json_and_picture(tmp_path):
 
 
 # -- issue 22's "done when", measured (README "Transitions"); strict xfails --------------------
-IN_FAMILY = [(a, b, r) for a, b in (("walk", "run"), ("run", "walk"), ("jump", "hop"),
-                                     ("hop", "jump")) for r in (0.0, 2.0)]
+# One protocol, the change at 8 s, open loop and with the recommended feedback gain (the issue
+# asks for both); the time was never chosen for a passing case (README: 8-14 s, measured).
+K_FB = RECOMMENDED["ml"]
+IN_FAMILY = [(a, b, r, k) for a, b in (("walk", "run"), ("run", "walk"), ("jump", "hop"),
+                                        ("hop", "jump")) for r in (0.0, 2.0) for k in (0.0, K_FB)]
 IN_FAMILY_SHORTFALL = {
-    ("walk", "run", 0.0): "the walk before the change is named none (left duty 0.547, below "
-                          "0.55, at the edge); a run 4 CPG cycles after it, no fall",
-    ("walk", "run", 2.0): "the walk before is named none (as the step's), a run after, no "
-                          "fall, but 12 CPG cycles after the change (4 asked)",
-    ("run", "walk", 0.0): "falls at 9.9 s, 1.9 s after the change",
-    ("run", "walk", 2.0): "falls at 10.1 s, as the ramp ends",
-    ("jump", "hop", 2.0): "falls at 10.9 s, 0.9 s after the ramp ends",
-    ("hop", "jump", 0.0): "falls at 16.1 s, 8.1 s after the change",
-    ("hop", "jump", 2.0): "falls at 15.2 s, 5.2 s after the ramp ends",
+    ("walk", "run", 0.0, 0.0): "the walk before the change is named none (left duty 0.547, "
+                               "below 0.55, at the edge); a run 4 CPG cycles after it, no fall",
+    ("walk", "run", 2.0, 0.0): "the walk before is named none (as the step's), a run after, no "
+                               "fall, but 12 CPG cycles after the change (4 asked)",
+    ("walk", "run", 0.0, K_FB): "falls at 9.9 s, 1.9 s after the change",
+    ("walk", "run", 2.0, K_FB): "the walk before is named none; a run 4 CPG cycles after, no "
+                                "fall",
+    ("run", "walk", 0.0, 0.0): "falls at 9.9 s, 1.9 s after the change",
+    ("run", "walk", 2.0, 0.0): "falls at 10.1 s, as the ramp ends",
+    ("run", "walk", 0.0, K_FB): "falls at 8.8 s, 0.8 s after the change",
+    ("run", "walk", 2.0, K_FB): "falls at 10.1 s, as the ramp ends",
+    ("jump", "hop", 2.0, 0.0): "falls at 10.9 s, 0.9 s after the ramp ends",
+    ("jump", "hop", 2.0, K_FB): "a hop 7 CPG cycles after the change (4 asked), no fall",
+    ("hop", "jump", 0.0, 0.0): "falls at 16.1 s, 8.1 s after the change",
+    ("hop", "jump", 2.0, 0.0): "falls at 15.2 s, 5.2 s after the ramp ends",
 }
 
 
-@pytest.mark.parametrize("a,b,ramp", [
-    pytest.param(a, b, r, marks=[pytest.mark.xfail(
-        raises=AssertionError, strict=True, reason=f"measured: {IN_FAMILY_SHORTFALL[a, b, r]}")]
-        if (a, b, r) in IN_FAMILY_SHORTFALL else [])
-    for a, b, r in IN_FAMILY])
-def test_in_family_transition(a, b, ramp):
+@pytest.mark.parametrize("a,b,ramp,k", [
+    pytest.param(a, b, r, k, id=f"{a}-{b}-ramp{r:g}-K{k:g}", marks=[pytest.mark.xfail(
+        raises=AssertionError, strict=True,
+        reason=f"measured: {IN_FAMILY_SHORTFALL[a, b, r, k]}")]
+        if (a, b, r, k) in IN_FAMILY_SHORTFALL else [])
+    for a, b, r, k in IN_FAMILY])
+def test_in_family_transition(a, b, ramp, k):
     """Issue 22: no fall; the physical gait before the change is A; after it, B within 4 CPG
     cycles of the change."""
-    res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0)
+    res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0, feedback=k)
     assert not res["fell"], res["fell_at_s"]
     assert res["before"]["physical_gait"] == a, res["before"]["physical_gait"]
     assert res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4, res["windows"]
