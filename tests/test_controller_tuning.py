@@ -437,3 +437,27 @@ def test_startup_gains_are_a_link_of_the_chain(tmp_path):
     assert e["started_from_sha256"] == params_sha256(CONTROL)
     assert e["startup_from_sha256"] == params_sha256(root)
     assert e["result_sha256"] == params_sha256(p) != params_sha256(CONTROL)
+
+
+def test_startup_tau_is_rechosen_on_the_live_gains_own_startup_corners(tmp_path):
+    """The chain's last link (scripts/tune_gains.sh): select_startup_tau without --startup-from
+    takes the live gains' own start-up corners, so that re-setting them with the chosen tau_s
+    changes nothing but tau_s; the committed gains hand over with the tau_s that selection
+    chose (envs/control/startup_selection_end.json)."""
+    import importlib.util
+    from pathlib import Path
+
+    from cpgbiped.envs.search.controller_tuning import params_sha256, set_startup
+
+    repo = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("select_startup_tau",
+                                                  repo / "scripts" / "select_startup_tau.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    own = mod.own_startup_corners(str(GAINS_FILE), tmp_path / "own.json")
+    src, _ = read_gains(own)
+    assert tuple(src.corner(c) for c in CORNER_OF.values()) == CONTROL.startup
+    chosen = json.loads((repo / "envs/control/startup_selection_end.json").read_text())["tau_s"]
+    assert CONTROL.startup_tau_s == chosen
+    set_startup(GAINS_FILE, own, chosen, tmp_path / "g.json", "a test")
+    assert params_sha256(read_gains(tmp_path / "g.json")[0]) == params_sha256(CONTROL)
