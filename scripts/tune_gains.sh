@@ -3,7 +3,7 @@
 # (envs/control/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
 # order, each started from the one before. Every run is deterministic (its seed, its tuning
 # conditions), so the chain ends with the committed parameters, bit for bit; the last line
-# checks it. About 182 minutes on 2 cores. Usage:
+# checks it. About 185 minutes on 2 cores. Usage:
 #     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
 # then `cp OUT/final/gains.json envs/control/gains.json` makes the result the controller's gains.
 set -euo pipefail
@@ -77,7 +77,9 @@ prev="$OUT/v1/gains.json"
 python3 scripts/lift_abort.py "$prev" "$OUT"
 prev="$OUT/la/gains.json"
 # tau_s re-chosen at the chain's end (README, "Start-up gains"): the links after the first choice
-# moved the corners it hands over to; the same rule, the same start-up corners (w4's).
+# moved the corners it hands over to; the same rule, the same start-up corners (w4's). The
+# committed envs/control/startup_selection_end.json was made with --live envs/control/gains.json
+# (the same parameters as la's but tau_s, which every candidate replaces): its counts must match.
 python3 scripts/select_startup_tau.py --live "$prev" --out "$OUT/startup_selection_end.json"
 python3 - "$OUT" "$prev" "$walk_end" <<'PY'
 import json, sys
@@ -91,6 +93,13 @@ set_startup(prev, walk_end, tau, f"{out}/s2/gains.json",
             "(envs/control/startup_selection_end.json)")
 PY
 prev="$OUT/s2/gains.json"
+python3 - "$OUT" <<'PY'
+import json, sys
+new = json.load(open(f"{sys.argv[1]}/startup_selection_end.json"))["candidates"]
+old = json.load(open("envs/control/startup_selection_end.json"))["candidates"]
+print("tune_gains: tau_s selection", "matches" if new == old else "DIFFERS from",
+      "envs/control/startup_selection_end.json")
+PY
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys
