@@ -49,6 +49,9 @@ def main() -> None:
                     "own start-up corners)")
     ap.add_argument("--out", required=True)
     ap.add_argument("--candidates", default=",".join(map(str, CANDIDATES)))
+    ap.add_argument("--apply", help="also write --live's gains with the chosen tau_s here "
+                    "(a link of scripts/tune_gains.sh)")
+    ap.add_argument("--note", default="", help="why, for --apply's provenance entry")
     a = ap.parse_args()
     from cpgbiped.envs.search.controller_tuning import set_startup
 
@@ -80,6 +83,10 @@ def main() -> None:
            "candidates": rows, "tau_s": best["tau_s"]}
     Path(a.out).write_text(json.dumps(out, indent=1) + "\n")
     print(f"select_startup_tau: tau_s = {best['tau_s']:g} (score {best['score']})")
+    if a.apply:
+        if not a.startup_from:
+            sys.exit("select_startup_tau: --apply needs --startup-from (its provenance names it)")
+        set_startup(a.live, a.startup_from, best["tau_s"], a.apply, a.note)
 
 
 if __name__ == "__main__":

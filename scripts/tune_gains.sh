@@ -48,19 +48,8 @@ stage jx2 --gait walk,jump --only 'synchronous.*' --conditions 1-8,21-24 --gens 
 # Start-up gains: the corners the chain had before the jump's stages start the body and hand
 # over to jx2's; tau_s chosen on CPG seeds 2000-2099 by a rule fixed in advance (3 minutes).
 python3 scripts/select_startup_tau.py --live "$prev" --startup-from "$walk_end" \
-    --out "$OUT/startup_selection.json"
-python3 - "$OUT" "$prev" "$walk_end" <<'PY'
-import json, sys
-from cpgbiped.envs.search.controller_tuning import set_startup
-out, prev, walk_end = sys.argv[1:4]
-tau = json.load(open(f"{out}/startup_selection.json"))["tau_s"]
-set_startup(prev, walk_end, tau, f"{out}/s1/gains.json",
-            "the jump corner of stage j2 jumps, but changed every walk's first steps (the "
-            "features start at a quarter of each corner); the corners the chain had before the "
-            "jump's stages (w4) start the body and hand over as exp(-t/tau_s); tau_s chosen by "
-            "scripts/select_startup_tau.py on CPG seeds 2000-2099 "
-            "(envs/control/startup_selection.json)")
-PY
+    --out "$OUT/startup_selection.json" --apply "$OUT/s1/gains.json" --note \
+    "the jump corner of stage j2 jumps, but changed every walk's first steps (the features start at a quarter of each corner); the corners the chain had before the jump's stages (w4) start the body and hand over as exp(-t/tau_s); tau_s chosen by scripts/select_startup_tau.py on CPG seeds 2000-2099 (envs/control/startup_selection.json)"
 prev="$OUT/s1/gains.json"
 # The jump's push (README, "Jump"): the corner's burst push set lower by hand, then searched
 # scored on the walk too, the walk guarded against the gains before it.
@@ -80,18 +69,9 @@ prev="$OUT/la/gains.json"
 # moved the corners it hands over to; the same rule, the same start-up corners (w4's). The
 # committed envs/control/startup_selection_end.json was made with --live envs/control/gains.json
 # (the same parameters as la's but tau_s, which every candidate replaces): its counts must match.
-python3 scripts/select_startup_tau.py --live "$prev" --out "$OUT/startup_selection_end.json"
-python3 - "$OUT" "$prev" "$walk_end" <<'PY'
-import json, sys
-from cpgbiped.envs.search.controller_tuning import set_startup
-out, prev, walk_end = sys.argv[1:4]
-tau = json.load(open(f"{out}/startup_selection_end.json"))["tau_s"]
-set_startup(prev, walk_end, tau, f"{out}/s2/gains.json",
-            "tau_s re-chosen after the jump's push, its speed term and the lift abort moved the "
-            "corners; the same rule and start-up corners (w4) as the first choice, by "
-            "scripts/select_startup_tau.py on CPG seeds 2000-2099 "
-            "(envs/control/startup_selection_end.json)")
-PY
+python3 scripts/select_startup_tau.py --live "$prev" --startup-from "$walk_end" \
+    --out "$OUT/startup_selection_end.json" --apply "$OUT/s2/gains.json" --note \
+    "tau_s re-chosen after the jump's push, its speed term and the lift abort moved the corners; the same rule and start-up corners (w4) as the first choice, by scripts/select_startup_tau.py on CPG seeds 2000-2099 (envs/control/startup_selection_end.json)"
 prev="$OUT/s2/gains.json"
 python3 - "$OUT" <<'PY'
 import json, sys
