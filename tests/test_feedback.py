@@ -258,6 +258,36 @@ def test_the_cpg_classifier_names_each_preset_from_the_closed_loop_cells(preset)
     assert v.cpg_gait == preset
 
 
+def test_the_recommended_gains_are_the_rule_applied_to_the_recorded_candidates():
+    """cpg/feedback_gains.json keeps every candidate's rollouts (scripts/feedback_choice.py).
+    Re-applied here, independently of the script: per network, a candidate is admissible when
+    no rollout falls and the CPG still names the gait it names open loop, for every preset and
+    every one of the four tuning CPG seeds; the recommendation is the best summed score among
+    the admissible ones with K > 0 (the first listed among equals)."""
+    from cpgbiped.cpg.feedback import GAINS_FILE
+
+    d = json.loads(GAINS_FILE.read_text())
+    rows = d["candidates"]
+    assert {r["cpg_seed"] for r in rows} == {1000, 1001, 1002, 1003}
+    assert all(r["cpg_seed"] >= 1000 for r in rows)  # tuning conditions, none a test's
+    for kind, chosen in d["networks"].items():
+        mine = [r for r in rows if r["network"] == kind]
+        named_open = {(r["preset"], r["cpg_seed"]): r["cpg_gait"] for r in mine if r["gain"] == 0}
+        order, score, ok = [], {}, {}
+        for r in mine:
+            if r["gain"] == 0:
+                continue
+            key = (r["form"], r["gain"])
+            if key not in score:
+                order.append(key)
+                score[key], ok[key] = 0.0, True
+            score[key] += min(r["forward_ns"]) + min(r["backward_ns"])
+            ok[key] &= (not r["fell"]) and r["cpg_gait"] == named_open[(r["preset"], r["cpg_seed"])]
+        best = max((k for k in order if ok[k]), key=lambda k: score[k])
+        assert best == (chosen["form"], chosen["recommended_gain"]), (kind, best, chosen)
+        assert CHOICE[kind] == best
+
+
 def test_the_touchdown_pulse_follows_each_landing_for_fifty_milliseconds():
     """Reset form: the extensor receives K (the flexor -K) for RESET_S after each landing,
     the landings taken here from the recorded loads (crossing LOAD_CONTACT upwards)."""
