@@ -1,5 +1,7 @@
 """The README's transition report: every ordered pair of primary gaits, as a step and as a 2 s
-ramp, open loop and with the recommended feedback; the drive sweeps walk<->run and jump<->hop.
+ramp, open loop and with the recommended feedback, with the network's own left-right
+synchrony after the change; the in-family pairs with the Hopf network (open loop); the drive
+sweeps walk<->run and jump<->hop.
 
     python scripts/report_transitions.py [--out out/report_transitions] [--workers 2]
                                          [--img docs/img]
@@ -28,11 +30,18 @@ PASS_CYCLES = 4  # issue 22: B within 4 CPG cycles of the change
 
 
 def _one(job):
-    a, b, ramp, K, at = job
+    a, b, ramp, K, at, kind = (*job, "ml")[:6]
     from cpgbiped.envs.experiments.transition import transition
 
-    res, *_ = transition("ml", a, b, at, ramp, at + ramp + 12.0, K)
+    res, *_ = transition(kind, a, b, at, ramp, at + ramp + 12.0, K)
     return res
+
+
+def _sync(r) -> str:
+    """The network's own extensor synchrony in the 2nd-4th CPG cycles after the change (0: the
+    legs' bursts alternate, 1: in phase), from the transition's JSON."""
+    xs = [x for x in r["cpg_extensor_synchrony"][1:4] if x is not None]
+    return "-" if not xs else f"{min(xs):.2f}-{max(xs):.2f}"
 
 
 def passes(r) -> bool:
@@ -75,17 +84,22 @@ def main(argv=None) -> int:
             for k in (0.0, K)]
     later = [(x, y, 0.0, k, at) for x, y in sorted(IN_FAMILY) for k in (0.0, K)
              for at in AT_S[1:]]
+    hopf = [(x, y, r, 0.0, AT_S[0], "hopf") for x, y in sorted(IN_FAMILY) for r in (0.0, 2.0)]
     sweeps = [(p, k) for p in ("walk-run", "jump-hop") for k in (0.0, K)]
     with ProcessPoolExecutor(a.workers) as ex:
         rows = list(ex.map(_one, jobs))
         times = list(ex.map(_one, later))
+        hopf_rows = list(ex.map(_one, hopf))
         sw = list(ex.map(_sweep, sweeps))
     md = ["### Transitions (Morris-Lecar, change at 8 s)", "",
           "before / after: the physical gait the contacts name before the change and once it "
           "has settled; cycles: CPG cycles from the change until the settled gait is the "
-          "target (- never).", "",
-          "| from -> to | change | K | before | after | fell | cycles | outcome |",
-          "|---|---|---|---|---|---|---|---|"]
+          "target (- never); CPG sync: the network's own extensor synchrony in the 2nd-4th "
+          "cycles after the change (share of the bursting time in which both legs' extensors "
+          "burst: 0 alternating, as a walk's or run's network; 1 in phase, as a jump's or "
+          "hop's).", "",
+          "| from -> to | change | K | before | after | fell | cycles | CPG sync | outcome |",
+          "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ok = r["after"]["physical_gait"] == r["to"] and not r["fell"]
         outcome = ("switched" if r["switched"] else
@@ -97,7 +111,17 @@ def main(argv=None) -> int:
                   f"{r['after']['physical_gait']} | "
                   f"{'%.1f s' % r['fell_at_s'] if r['fell'] else 'no'} | "
                   f"{'-' if r['cycles_to_switch'] is None else r['cycles_to_switch']} | "
-                  f"{outcome} |")
+                  f"{_sync(r)} | {outcome} |")
+    md += ["", "### In-family transitions, Hopf network (open loop, change at 8 s)", "",
+           "| from -> to | change | before | after | fell | cycles | CPG sync | passes |",
+           "|---|---|---|---|---|---|---|---|"]
+    for r in hopf_rows:
+        md.append(f"| {r['from']} -> {r['to']} | "
+                  f"{'step' if r['ramp_s'] == 0 else 'ramp %g s' % r['ramp_s']} | "
+                  f"{r['before']['physical_gait']} | {r['after']['physical_gait']} | "
+                  f"{'%.1f s' % r['fell_at_s'] if r['fell'] else 'no'} | "
+                  f"{'-' if r['cycles_to_switch'] is None else r['cycles_to_switch']} | "
+                  f"{_sync(r)} | {'**yes**' if passes(r) else 'no'} |")
     md += ["", "### In-family steps against the time of the change", "",
            "before -> after, and the CPG cycles to the switch; in bold where issue 22's test "
            f"passes (no fall, A before, B within {PASS_CYCLES} cycles).", "",
@@ -127,6 +151,7 @@ def main(argv=None) -> int:
     text = "\n".join(md) + "\n"
     write_text(Path(out) / "report.md", text)
     (Path(out) / "report.json").write_text(json.dumps({"transitions": rows, "change_times": times,
+                                                       "hopf_in_family": hopf_rows,
                                                        "sweeps": sw},
                                                       indent=1, default=float))
     if a.img:

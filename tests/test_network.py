@@ -141,6 +141,27 @@ def test_step_change_keeps_the_state_and_reaches_the_new_gait():
     assert moved.v[moved.t_model >= at][0] == pytest.approx(plain.v[plain.t_model >= at][0])
 
 
+@pytest.mark.parametrize("ramp_periods", [0.0, 1.9])
+def test_from_the_run_to_the_walk_the_network_hops_for_several_cycles_first(ramp_periods):
+    """The Morris-Lecar network, moved from the run's parameters (Table 3 state) to the walk's,
+    as a step or a ramp of about 2 s (1.9 walk periods), is named a hop by the classifier over
+    the 1st to 7th walk periods after the change (all four cells in phase) and a walk only
+    later (25-40 periods): the body cannot walk within 4 cycles of such a change while the
+    network drives both legs together (issue 22; tests/test_transition.py)."""
+    a, b = build("ml", "run"), build("ml", "walk")
+    T = b.period()
+    at = 100.0
+    out = a.outputs(at + 40 * T, to=b, schedule=Schedule.change(at, ramp_periods * T))
+    t, v = out.t_model, out.v
+
+    def named(lo, hi):
+        w = (t >= at + lo * T) & (t < at + hi * T)
+        return classify(t[w], v[w])[0]
+
+    assert named(1, 7) == "hop"
+    assert named(25, 40) == "walk"
+
+
 def test_ramp_matches_the_numpy_reference_and_blend():
     a, b = build("ml", "jump"), build("ml", "hop")
     sch = Schedule.change(20.0, 10.0)

@@ -133,10 +133,18 @@ IN_FAMILY_SHORTFALL = {
     ("walk", "run", 0.0, K_FB): "falls at 9.9 s, 1.9 s after the change",
     ("walk", "run", 2.0, K_FB): "the walk before is named none; a run 4 CPG cycles after, no "
                                 "fall",
-    ("run", "walk", 0.0, 0.0): "falls at 9.9 s, 1.9 s after the change",
-    ("run", "walk", 2.0, 0.0): "falls at 10.1 s, as the ramp ends",
-    ("run", "walk", 0.0, K_FB): "falls at 8.8 s, 0.8 s after the change",
-    ("run", "walk", 2.0, K_FB): "falls at 10.1 s, as the ramp ends",
+    # run -> walk open loop: the network's own extensors burst in phase for 8+ cycles after
+    # the change; with feedback they alternate from the 3rd cycle and the body falls anyway
+    # (test_from_the_run_to_the_walk_the_open_loop_network_hops_and_feedback_undoes_it)
+    ("run", "walk", 0.0, 0.0): "falls at 9.9 s, 1.9 s after the change; the network bursts "
+                               "both legs together from the 2nd cycle on",
+    ("run", "walk", 2.0, 0.0): "falls at 10.1 s, as the ramp ends; the network bursts both "
+                               "legs together from the 3rd cycle on",
+    ("run", "walk", 0.0, K_FB): "falls at 8.8 s, 0.8 s after the change (the closed-loop "
+                                "network alternates its bursts from the 2nd cycle: the body's "
+                                "failure)",
+    ("run", "walk", 2.0, K_FB): "falls at 10.1 s, as the ramp ends (the closed-loop network "
+                                "alternates its bursts from the 3rd cycle: the body's failure)",
     ("jump", "hop", 2.0, 0.0): "falls at 10.9 s, 0.9 s after the ramp ends",
     ("jump", "hop", 2.0, K_FB): "a hop 7 CPG cycles after the change (4 asked), no fall",
     ("hop", "jump", 0.0, 0.0): "falls at 16.1 s, 8.1 s after the change",
@@ -154,6 +162,77 @@ def test_in_family_transition(a, b, ramp, k):
     """Issue 22: no fall; the physical gait before the change is A; after it, B within 4 CPG
     cycles of the change."""
     res, *_ = transition("ml", a, b, 8.0, ramp, 8.0 + ramp + 12.0, feedback=k)
+    assert not res["fell"], res["fell_at_s"]
+    assert res["before"]["physical_gait"] == a, res["before"]["physical_gait"]
+    assert res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4, res["windows"]
+
+
+def test_extensor_synchrony_is_zero_for_alternating_and_one_for_in_phase_bursts():
+    """On square bursts made here: the legs' extensors half a cycle apart share no time; in
+    phase they share all of it; a quarter cycle apart, a third of the time either bursts
+    (both for 1/4 of a cycle, either for 3/4)."""
+    from cpgbiped.envs.experiments.transition import extensor_synchrony
+
+    t = np.arange(0.0, 10.0, 0.001)
+    burst = lambda lag: ((t / 1.0 + lag) % 1.0 < 0.5).astype(float)  # noqa: E731
+    for lag, want in ((0.5, 0.0), (0.0, 1.0), (0.25, 1 / 3)):
+        act = np.column_stack([np.zeros_like(t), np.zeros_like(t), burst(0.0), burst(lag)])
+        got = extensor_synchrony(t, act, 2.0, 1.0, n=5)
+        assert np.allclose(got, want, atol=0.01), (lag, got)
+    assert extensor_synchrony(t, act, 8.0, 1.0, n=3)[2] is None  # past the recording
+
+
+@pytest.mark.parametrize("ramp", [0.0, 2.0])
+def test_from_the_run_to_the_walk_the_open_loop_network_hops_and_feedback_undoes_it(ramp):
+    """Why run -> walk cannot pass issue 22's test open loop with the Morris-Lecar network,
+    whatever the body does: moved from the run's parameters to the walk's, the network's own
+    extensors burst in phase (a hop's pattern) in the third and fourth CPG cycles after the
+    change, inside the four cycles the test allows for a walk (measured: to the eighth and
+    beyond; the CPG classifier names hop 1-7 cycles after the change, tests/test_network.py).
+    The network stepped tick by tick without input does the same (the closed loop's
+    integrator is not what differs); with the body's feedback at the recommended gain the
+    bursts alternate by then; the Hopf network, swapped in, alternates them open loop."""
+    from cpgbiped.envs.experiments.transition import extensor_synchrony
+
+    ml, *_ = transition("ml", "run", "walk", 8.0, ramp, 8.0 + ramp + 6.0)
+    assert min(ml["cpg_extensor_synchrony"][2:4]) > 0.9, ml["cpg_extensor_synchrony"]
+    a, b = build("ml", "run"), build("ml", "walk")
+    n = int((8.0 + ramp + 6.0) / 0.004)
+    v = run_open(loop_network(a, 0.0, 0.004, n * 0.004, to=b,
+                              change=Schedule.change(8.0, ramp)), n)
+    stepped = extensor_synchrony(np.arange(n + 1) * 0.004, a.activation(v), 8.0,
+                                 b.period() / b.units_per_s)
+    assert min(stepped[2:4]) > 0.9, stepped
+    fb, *_ = transition("ml", "run", "walk", 8.0, ramp, 8.0 + ramp + 6.0, feedback=K_FB)
+    assert max(fb["cpg_extensor_synchrony"][2:4]) < 0.1, fb["cpg_extensor_synchrony"]
+    hopf, *_ = transition("hopf", "run", "walk", 8.0, ramp, 8.0 + ramp + 6.0)
+    assert all(x is None or x < 0.2 for x in hopf["cpg_extensor_synchrony"][2:4]), \
+        hopf["cpg_extensor_synchrony"]
+
+
+# The Hopf network's in-family transitions, open loop (its closed loop refuses a parameter
+# change), at the same 8 s protocol; measured shortfalls of the ones that do not pass.
+HOPF_SHORTFALL = {
+    ("walk", "run", 0.0): "falls at 14.9 s, 6.9 s after the change",
+    ("run", "walk", 0.0): "falls at 9.7 s, 1.7 s after the change; the network's bursts "
+                          "alternate from the change on: the body's failure",
+    ("run", "walk", 2.0): "falls at 9.8 s, during the ramp",
+    ("jump", "hop", 0.0): "the Hopf jump falls at 4.7 s, before the change",
+    ("jump", "hop", 2.0): "the Hopf jump falls at 4.7 s, before the change",
+    ("hop", "jump", 0.0): "falls at 14.9 s, 6.9 s after the change",
+    ("hop", "jump", 2.0): "falls at 12.3 s, 2.3 s after the ramp ends",
+}
+
+
+@pytest.mark.parametrize("a,b,ramp", [
+    pytest.param(a, b, r, id=f"hopf-{a}-{b}-ramp{r:g}", marks=[pytest.mark.xfail(
+        raises=AssertionError, strict=True, reason=f"measured: {HOPF_SHORTFALL[a, b, r]}")]
+        if (a, b, r) in HOPF_SHORTFALL else [])
+    for a, b in (("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump"))
+    for r in (0.0, 2.0)])
+def test_hopf_in_family_transition(a, b, ramp):
+    """Issue 22's test with the Hopf network driving the same controller."""
+    res, *_ = transition("hopf", a, b, 8.0, ramp, 8.0 + ramp + 12.0)
     assert not res["fell"], res["fell_at_s"]
     assert res["before"]["physical_gait"] == a, res["before"]["physical_gait"]
     assert res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4, res["windows"]

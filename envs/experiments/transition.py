@@ -15,6 +15,14 @@ Windows, all measured from the foot contacts (:func:`cpgbiped.envs.gaits.validat
 
 With the closed loop (``feedback`` K > 0; Morris-Lecar) the network is stepped with the body
 through the change.
+
+``cpg_extensor_synchrony``: what the network itself does after the change, read from its
+activations, never from the body: for each of the first ``SYNC_CYCLES`` CPG cycles of B from
+the change, the share of the time in which either leg's extensor activation is at least
+``E_ON`` (the controller's stance command) during which both are: 0 when the legs' bursts
+alternate (a walk's or a run's network), 1 when they are in phase (a jump's or a hop's). A
+body cannot walk within a few cycles of a change while its network drives both legs' stances
+together.
 """
 from __future__ import annotations
 
@@ -31,6 +39,8 @@ from cpgbiped.envs.simulation.rollout import check_seconds, rollout, window
 from cpgbiped.envs.gaits.validate import measure_recording
 
 WINDOW_CYCLES = 3  # CPG cycles of the target per sliding window
+SYNC_CYCLES = 8  # CPG cycles of the target after the change with an extensor synchrony
+E_ON = 0.5  # extensor activation of the controller's stance command (gains.json's e_on)
 KEYS = ("physical_gait", "cpg_gait", "fell", "duty_factor", "lr_phase_lag", "double_support",
         "flight", "stride_period_s", "speed_mps", "froude", "apex_height_m")
 
@@ -69,6 +79,23 @@ def window_summary(net, rec, t0, t1, fell_at):
                                           "end_s": float(rec.t[-1] if t1 is None else t1)}
 
 
+def extensor_synchrony(t_s, activation, at_s: float, period_s: float,
+                       n: int = SYNC_CYCLES) -> list:
+    """Per cycle k = 0..n-1 of [at_s + k T, at_s + (k + 1) T]: time with both extensors (cells
+    LE, RE: columns 2, 3 of ``activation``) at or above E_ON over time with either; None for a
+    cycle outside the recording or without any extensor burst."""
+    on = np.asarray(activation)[:, 2:4] >= E_ON
+    out = []
+    for k in range(n):
+        w = (t_s >= at_s + k * period_s) & (t_s < at_s + (k + 1) * period_s)
+        either = int((on[w, 0] | on[w, 1]).sum())
+        if t_s[-1] < at_s + (k + 1) * period_s - 1e-9 or either == 0:
+            out.append(None)
+        else:
+            out.append(float((on[w, 0] & on[w, 1]).sum() / either))
+    return out
+
+
 def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0,
                seconds: float = 20.0, feedback: float = 0.0, poses: bool = False):
     """(result dict, recording, the network A, the network B)."""
@@ -101,7 +128,8 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
            "cycles_to_switch": (settled if settled is not None and names[settled] == b
                                 and fell_at is None else None),
            "windows": [{"start_s": w["start_s"], "physical_gait": w["physical_gait"]}
-                       for w in slides]}
+                       for w in slides],
+           "cpg_extensor_synchrony": extensor_synchrony(rec.t, rec.drive, at_s, T)}
     res["switched"] = bool(res["cycles_to_switch"] is not None
                            and before["physical_gait"] == a and not res["fell"])
     return res, rec, net, to
