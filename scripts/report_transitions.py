@@ -30,7 +30,7 @@ PASS_CYCLES = 4  # issue 22: B within 4 CPG cycles of the change
 
 
 def _one(job):
-    a, b, ramp, K, at, kind = (*job, "ml")[:6]
+    kind, a, b, ramp, K, at = job
     from cpgbiped.envs.experiments.transition import transition
 
     res, *_ = transition(kind, a, b, at, ramp, at + ramp + 12.0, K)
@@ -80,11 +80,11 @@ def main(argv=None) -> int:
 
     out = ensure_dir(a.out)
     K = RECOMMENDED["ml"]
-    jobs = [(x, y, r, k, AT_S[0]) for x in GAITS for y in GAITS if x != y for r in (0.0, 2.0)
+    jobs = [("ml", x, y, r, k, AT_S[0]) for x in GAITS for y in GAITS if x != y for r in (0.0, 2.0)
             for k in (0.0, K)]
-    later = [(x, y, 0.0, k, at) for x, y in sorted(IN_FAMILY) for k in (0.0, K)
+    later = [("ml", x, y, 0.0, k, at) for x, y in sorted(IN_FAMILY) for k in (0.0, K)
              for at in AT_S[1:]]
-    hopf = [(x, y, r, 0.0, AT_S[0], "hopf") for x in GAITS for y in GAITS if x != y
+    hopf = [("hopf", x, y, r, 0.0, AT_S[0]) for x in GAITS for y in GAITS if x != y
             for r in (0.0, 2.0)]
     sweeps = [(p, k) for p in ("walk-run", "jump-hop") for k in (0.0, K)]
     with ProcessPoolExecutor(a.workers) as ex:

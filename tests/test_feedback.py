@@ -268,8 +268,7 @@ def test_the_recommended_gains_are_the_rule_applied_to_the_recorded_candidates()
 
     d = json.loads(GAINS_FILE.read_text())
     rows = d["candidates"]
-    assert {r["cpg_seed"] for r in rows} == {1000, 1001, 1002, 1003}
-    assert all(r["cpg_seed"] >= 1000 for r in rows)  # tuning conditions, none a test's
+    assert {r["cpg_seed"] for r in rows} == {1000, 1001, 1002, 1003}  # tuning conditions
     for kind, chosen in d["networks"].items():
         mine = [r for r in rows if r["network"] == kind]
         named_open = {(r["preset"], r["cpg_seed"]): r["cpg_gait"] for r in mine if r["gain"] == 0}

@@ -34,13 +34,14 @@ from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import PRESETS, build
 
+from cpgbiped.envs.control.controller import CONTROL
 from cpgbiped.envs.gaits.criteria import SETTLE_S
 from cpgbiped.envs.simulation.rollout import check_seconds, rollout, window
 from cpgbiped.envs.gaits.validate import measure_recording
 
 WINDOW_CYCLES = 3  # CPG cycles of the target per sliding window
 SYNC_CYCLES = 8  # CPG cycles of the target after the change with an extensor synchrony
-E_ON = 0.5  # extensor activation of the controller's stance command (gains.json's e_on)
+E_ON = CONTROL.e_on  # extensor activation of the controller's stance command
 KEYS = ("physical_gait", "cpg_gait", "fell", "duty_factor", "lr_phase_lag", "double_support",
         "flight", "stride_period_s", "speed_mps", "froude", "apex_height_m")
 
