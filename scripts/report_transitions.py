@@ -56,7 +56,7 @@ def _cell(r) -> str:
         return "fell %.1f s" % r["fell_at_s"]
     c = r["cycles_to_switch"]
     txt = f"{r['before']['physical_gait']} -> {r['after']['physical_gait']}"
-    txt += "" if c is None else f", {c} cycles"
+    txt += "" if c is None else f", {c} cycle" + ("" if c == 1 else "s")
     return f"**{txt}**" if passes(r) else txt
 
 

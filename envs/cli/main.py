@@ -765,7 +765,8 @@ def cmd_phase_response(a) -> int:
 def cmd_transition(a) -> int:
     from cpgbiped.cpg import io
     from cpgbiped.envs.media.render import check_backend, check_video_size, gait_diagram, render_video
-    from cpgbiped.envs.experiments.transition import WINDOW_CYCLES, check_transition, transition
+    from cpgbiped.envs.experiments.transition import (BEFORE_CYCLES, WINDOW_CYCLES,
+                                                      check_transition, transition)
 
     seconds = a.seconds if a.seconds is not None else a.at + a.ramp + 12.0
     check_transition(a.network, getattr(a, "from"), a.to, a.at, a.ramp, seconds)
@@ -799,8 +800,11 @@ def cmd_transition(a) -> int:
     else:
         b, f = res["before"], res["after"]
         print(label)
-        print(f"  before ({b['start_s']:g}-{b['end_s']:g} s): physical {b['physical_gait']}, "
-              f"CPG {b['cpg_gait']}, {b['speed_mps']:.2f} m/s")
+        w = res["before_from_settling"]
+        print(f"  before ({b['start_s']:.2f}-{b['end_s']:g} s, its last {BEFORE_CYCLES} CPG "
+              f"cycles): physical {b['physical_gait']}, CPG {b['cpg_gait']}, "
+              f"{b['speed_mps']:.2f} m/s (from {w['start_s']:g} s: physical "
+              f"{w['physical_gait']})")
         print(f"  after  ({f['start_s']:.2f}-{f['end_s']:g} s): physical {f['physical_gait']}, "
               f"CPG {f['cpg_gait']}, {f['speed_mps']:.2f} m/s")
         print(f"  sliding windows of {WINDOW_CYCLES} CPG cycles: "

@@ -6,7 +6,12 @@ over ``ramp_s`` seconds (:class:`cpg.integrate.Schedule`). The CPG's state carri
 change; nothing is reset, and the controller is not told (it never sees a name).
 
 Windows, all measured from the foot contacts (:func:`cpgbiped.envs.gaits.validate.measure_recording`):
-- **before**: from the end of the settling window to the change;
+- **before**: the last ``BEFORE_CYCLES`` whole CPG cycles of A before the change (from the
+  end of the settling window if the change comes sooner): the gait the body is in when the
+  change comes, so that the body's start-up (the controller's start-up gains hand over with
+  a time constant of 1.5 s) is not counted as the gait before the change. Whole cycles, as
+  a duty factor over part of a stride is biased by the part. ``before_from_settling``: the whole stretch from the end of the
+  settling window to the change (what ``before`` was until 2026-12-03);
 - **sliding**: ``WINDOW_CYCLES`` CPG cycles of B starting 0, 1, 2, ... cycles after the change
   began, while such a window fits in the rollout;
 - **after**: from the first sliding window from which every later one names the same physical
@@ -40,6 +45,8 @@ from cpgbiped.envs.simulation.rollout import check_seconds, rollout, window
 from cpgbiped.envs.gaits.validate import measure_recording
 
 WINDOW_CYCLES = 3  # CPG cycles of the target per sliding window
+BEFORE_CYCLES = 5  # whole CPG cycles of A before the change (the CPG classifier needs 3 whole
+# cycles between its reference's upcrossings; 4 left the jump's unnamed)
 SYNC_CYCLES = 8  # CPG cycles of the target after the change with an extensor synchrony
 E_ON = CONTROL.e_on  # extensor activation of the controller's stance command
 KEYS = ("physical_gait", "cpg_gait", "fell", "duty_factor", "lr_phase_lag", "double_support",
@@ -106,7 +113,9 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
                   stop_on_fall=False, feedback=feedback)
     fell_at = rec.fell_at
     T = to.period_s()
-    before = window_summary(net, rec, SETTLE_S, at_s, fell_at)
+    before = window_summary(net, rec, max(SETTLE_S, at_s - BEFORE_CYCLES * net.period_s()),
+                            at_s, fell_at)
+    from_settling = window_summary(net, rec, SETTLE_S, at_s, fell_at)
     slides = []
     k = 0
     while at_s + (k + WINDOW_CYCLES) * T <= rec.t[-1] + 1e-9:
@@ -123,7 +132,8 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
     after = window_summary(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
     res = {"network": kind, "from": a, "to": b, "at_s": float(at_s), "ramp_s": float(ramp_s),
            "seconds": seconds, "feedback_gain": rec.feedback_gain, "cpg_period_to_s": T,
-           "before": before, "after": after, "fell": fell_at is not None,
+           "before": before, "before_from_settling": from_settling, "after": after,
+           "fell": fell_at is not None,
            "fell_at_s": fell_at,
            "settled_after_cycles": settled,
            "cycles_to_switch": (settled if settled is not None and names[settled] == b
