@@ -135,8 +135,8 @@ def test_sweep_cli_writes_its_json_and_picture(tmp_path):
 # One protocol, the change at 8 s, open loop and with the recommended feedback gain (the issue
 # asks for both); the time was never chosen for a passing case (README: 8-14 s, measured).
 K_FB = RECOMMENDED["ml"]
-IN_FAMILY = [(a, b, r, k) for a, b in (("walk", "run"), ("run", "walk"), ("jump", "hop"),
-                                        ("hop", "jump")) for r in (0.0, 2.0) for k in (0.0, K_FB)]
+IN_FAMILY_PAIRS = (("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump"))
+IN_FAMILY = [(a, b, r, k) for a, b in IN_FAMILY_PAIRS for r in (0.0, 2.0) for k in (0.0, K_FB)]
 IN_FAMILY_SHORTFALL = {
     ("walk", "run", 2.0, 0.0): "a run after the change, no fall, but 12 CPG cycles after it "
                                "(4 asked)",
@@ -177,6 +177,45 @@ def _assert_issue_22_passes(kind, a, b, ramp, k=0.0):
     assert not res["fell"], res["fell_at_s"]
     assert res["before"]["physical_gait"] == a, res["before"]["physical_gait"]
     assert res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4, res["windows"]
+
+
+# Cross-family pairs (issue 22: at least 4 of the 8 reach their target): the change at 8 s, each
+# pair run the four ways (step or 2 s ramp, open loop or the recommended feedback) for the
+# command line's default length (30 s after the change: the network alone takes up to 300
+# model units, 24 s, to lock to the other family's pattern). A pair is reached when one way
+# ends in the target's physical gait without a fall.
+CROSS = [(a, b) for a in ("walk", "run", "jump", "hop") for b in ("walk", "run", "jump", "hop")
+         if a != b and (a, b) not in IN_FAMILY_PAIRS]
+CROSS_SHORTFALL = {
+    ("walk", "jump"): "falls 1.1-2.5 s after the change (at 9.1-10.5 s), all four ways",
+    ("run", "jump"): "falls 1.4-2.6 s after the change (at 9.4-10.6 s), all four ways",
+    ("run", "hop"): "falls 1.4-2.8 s after the change (at 9.4-10.8 s), all four ways",
+}
+
+
+@pytest.mark.parametrize("a,b", [
+    pytest.param(a, b, id=f"{a}-{b}", marks=[pytest.mark.xfail(
+        raises=AssertionError, strict=True, reason=f"measured: {CROSS_SHORTFALL[a, b]}")]
+        if (a, b) in CROSS_SHORTFALL else []) for a, b in CROSS])
+def test_cross_family_pair_is_reached_in_one_of_four_ways(a, b):
+    from cpgbiped.envs.experiments.transition import default_seconds
+
+    outcomes = []
+    for ramp in (0.0, 2.0):
+        for k in (0.0, K_FB):
+            res, *_ = transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
+                                 feedback=k)
+            outcomes.append((ramp, k, res["fell_at_s"], res["after"]["physical_gait"]))
+            if not res["fell"] and res["after"]["physical_gait"] == b:
+                return
+    raise AssertionError(outcomes)
+
+
+def test_the_default_rollout_is_longer_across_the_families():
+    from cpgbiped.envs.experiments.transition import default_seconds
+
+    assert default_seconds("walk", "run", 8.0, 2.0) == 22.0
+    assert default_seconds("hop", "walk", 8.0, 0.0) == 38.0
 
 
 def test_extensor_synchrony_is_zero_for_alternating_and_one_for_in_phase_bursts():

@@ -766,9 +766,11 @@ def cmd_transition(a) -> int:
     from cpgbiped.cpg import io
     from cpgbiped.envs.media.render import check_backend, check_video_size, gait_diagram, render_video
     from cpgbiped.envs.experiments.transition import (BEFORE_CYCLES, WINDOW_CYCLES,
-                                                      check_transition, transition)
+                                                      check_transition, default_seconds,
+                                                      transition)
 
-    seconds = a.seconds if a.seconds is not None else a.at + a.ramp + 12.0
+    seconds = (a.seconds if a.seconds is not None
+               else default_seconds(getattr(a, "from"), a.to, a.at, a.ramp))
     check_transition(a.network, getattr(a, "from"), a.to, a.at, a.ramp, seconds)
     K = feedback_gain(a, a.network)
     if a.out:
@@ -1042,7 +1044,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--ramp", type=finite_arg, default=0.0, metavar="R_S",
                     help="ramp length, s (default 0: a step)")
     sp.add_argument("--seconds", type=seconds_arg, default=None,
-                    help="whole rollout, s (default: the change's end + 12 s)")
+                    help="whole rollout, s (default: the change's end + 12 s within a family, "
+                         "walk <-> run or jump <-> hop, + 30 s across them, where the network "
+                         "takes longer to lock)")
     sp.add_argument("--network", default="ml", choices=("ml", "hopf"))
     feedback_option(sp, " (Morris-Lecar)")
     sp.add_argument("--width", type=count_arg(1), default=640)

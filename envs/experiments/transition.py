@@ -45,12 +45,23 @@ from cpgbiped.envs.simulation.rollout import check_seconds, rollout, window
 from cpgbiped.envs.gaits.validate import measure_recording
 
 WINDOW_CYCLES = 3  # CPG cycles of the target per sliding window
+AFTER_S = 12.0  # s of rollout after the change ends by default, within a family (walk <-> run,
+# jump <-> hop)
+CROSS_AFTER_S = 30.0  # ... across the families: the network alone takes 100-300 model units
+# (8-24 s at 12.3 units/s) to lock to a new pattern (issue 22), and the windows need 3 cycles
+IN_FAMILY = frozenset({("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump")})
 BEFORE_CYCLES = 5  # whole CPG cycles of A before the change (the CPG classifier needs 3 whole
 # cycles between its reference's upcrossings; 4 left the jump's unnamed)
 SYNC_CYCLES = 8  # CPG cycles of the target after the change with an extensor synchrony
 E_ON = CONTROL.e_on  # extensor activation of the controller's stance command
 KEYS = ("physical_gait", "cpg_gait", "fell", "duty_factor", "lr_phase_lag", "double_support",
         "flight", "stride_period_s", "speed_mps", "froude", "apex_height_m")
+
+
+def default_seconds(a: str, b: str, at_s: float, ramp_s: float) -> float:
+    """The rollout's default length: the change's end plus AFTER_S within a family, plus
+    CROSS_AFTER_S across the families."""
+    return at_s + ramp_s + (AFTER_S if (a, b) in IN_FAMILY else CROSS_AFTER_S)
 
 
 def check_transition(kind: str, a: str, b: str, at_s: float, ramp_s: float, seconds: float):
