@@ -5,7 +5,12 @@ states says more. Each preset (Table 2 weights) starts from the random CPG state
 in [--first, --first + --n) and is validated for 20 s after settling, as ``cpgbiped validate``
 does, with the committed gains or --gains FILE:
 
-    python scripts/census.py walk,run,jump,hop --first 3000 --n 30 [--gains FILE] [-v]
+    python scripts/census.py walk,run,jump,hop --first 3000 --n 30 [--gains FILE]
+                             [--friction F] [--push T I] [-v]
+
+--friction scales the floor's friction, --push gives the torso a horizontal impulse of I N s
+at T s (simulation time, settling included), as ``validate`` does: the perturbations of the
+tests measured over many states instead of one.
 
 Seeds 3000 and up are neither tuning conditions (1000-1099) nor the tests' (10-19).
 Prints, per gait, how many pass every criterion, how many are named their own gait by the
@@ -17,13 +22,14 @@ from concurrent.futures import ProcessPoolExecutor
 
 
 def one(job):
-    gait, seed, gains = job
+    gait, seed, gains, friction, push = job
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL, read_gains
     from cpgbiped.envs.gaits.validate import validate
 
     params = read_gains(gains)[0] if gains else CONTROL
-    s = validate(build("ml", gait, seed=seed), gait, 20.0, params=params).summary()
+    s = validate(build("ml", gait, seed=seed), gait, 20.0, params=params,
+                 friction_scale=friction, push=push).summary()
     return gait, seed, s, s["failures"]
 
 
@@ -33,10 +39,15 @@ def main() -> None:
     ap.add_argument("--first", type=int, default=3000)
     ap.add_argument("--n", type=int, default=30)
     ap.add_argument("--gains", default=None, help="a gains file (default: the committed one)")
+    ap.add_argument("--friction", type=float, default=1.0, help="floor friction scale")
+    ap.add_argument("--push", type=float, nargs=2, default=None, metavar=("T_S", "IMPULSE_NS"),
+                    help="a horizontal push on the torso at T_S s of IMPULSE_NS N s")
     ap.add_argument("-v", action="store_true", help="one line per failing rollout")
     a = ap.parse_args()
     gaits = a.gaits.split(",")
-    jobs = [(g, s, a.gains) for g in gaits for s in range(a.first, a.first + a.n)]
+    push = tuple(a.push) if a.push else None
+    jobs = [(g, s, a.gains, a.friction, push) for g in gaits
+            for s in range(a.first, a.first + a.n)]
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
         res = list(ex.map(one, jobs))
     for g in gaits:
