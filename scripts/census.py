@@ -42,6 +42,9 @@ def main() -> None:
     ap.add_argument("--friction", type=float, default=1.0, help="floor friction scale")
     ap.add_argument("--push", type=float, nargs=2, default=None, metavar=("T_S", "IMPULSE_NS"),
                     help="a horizontal push on the torso at T_S s of IMPULSE_NS N s")
+    ap.add_argument("--matrix", action="store_true",
+                    help="also count the states from which every named preset gives its own "
+                         "physical gait (the matrix's diagonal, `cpgbiped matrix --seed S`)")
     ap.add_argument("-v", action="store_true", help="one line per failing rollout")
     a = ap.parse_args()
     gaits = a.gaits.split(",")
@@ -61,6 +64,14 @@ def main() -> None:
             for _, seed, s, fails in rows:
                 if fails:
                     print(f"   seed {seed}: {'; '.join(fails)[:160]}")
+
+
+    if a.matrix:
+        seeds = range(a.first, a.first + a.n)
+        full = [sd for sd in seeds
+                if all(r[2]["physical_gait"] == r[0] for r in res if r[1] == sd)]
+        print(f"every preset its own gait (the matrix's diagonal {len(gaits)}/{len(gaits)}) "
+              f"from {len(full)}/{len(seeds)} states")
 
 
 if __name__ == "__main__":
