@@ -1406,8 +1406,26 @@ def _main(argv: list[str] | None) -> int:
 def run() -> int:
     """The console entry point: :func:`main`, which leaves Ctrl-C and SIGTERM ignored while
     the interpreter shuts down (the run is over and its outputs are in place: an interrupt
-    then would only print a traceback and exit -2)."""
-    return main(ignore_signals_after=True)
+    then would only print a traceback and exit -2). An interrupted or terminated run (130,
+    143) has already cleaned up on its way out (staging folders removed, worker processes
+    shut down), so it leaves without the interpreter's finalization: once in some hundred
+    SIGTERMs a native thread still running there (seen in ``optimize --physics``) aborted
+    the finalizing interpreter ("PyThreadState_Get: the function must be called with the GIL
+    held", exit -6) after the one line had been printed."""
+    code = main(ignore_signals_after=True)
+    if code in (130, 143):
+        import atexit
+        import threading
+
+        # what the interpreter's finalization does first, in its order (join the threads and
+        # their exit hooks - concurrent.futures' among them - then the atexit functions:
+        # multiprocessing's release its semaphores), and then leave before the teardown
+        threading._shutdown()
+        atexit._run_exitfuncs()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
 
 
 if __name__ == "__main__":
