@@ -22,6 +22,8 @@ from concurrent.futures import ProcessPoolExecutor
 
 
 def one(job):
+    """One preset from one random CPG state under one perturbation: (gait, seed, summary,
+    failed criteria)."""
     gait, seed, gains, friction, push = job
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL, read_gains
@@ -41,7 +43,7 @@ def main() -> None:
     ap.add_argument("--gains", default=None, help="a gains file (default: the committed one)")
     ap.add_argument("--friction", type=float, default=1.0, help="floor friction scale")
     ap.add_argument("--push", type=float, nargs=2, default=None, metavar=("T_S", "IMPULSE_NS"),
-                    help="a horizontal push on the torso at T_S s of IMPULSE_NS N s")
+                    help="a horizontal push on the torso at T_S s of IMPULSE_NS N s (> 0 forwards)")
     ap.add_argument("--matrix", action="store_true",
                     help="also count the states from which every named preset gives its own "
                          "physical gait (the matrix's diagonal, `cpgbiped matrix --seed S`)")
@@ -64,14 +66,13 @@ def main() -> None:
             for _, seed, s, fails in rows:
                 if fails:
                     print(f"   seed {seed}: {'; '.join(fails)[:160]}")
-
-
     if a.matrix:
         seeds = range(a.first, a.first + a.n)
         full = [sd for sd in seeds
                 if all(r[2]["physical_gait"] == r[0] for r in res if r[1] == sd)]
-        print(f"every preset its own gait (the matrix's diagonal {len(gaits)}/{len(gaits)}) "
-              f"from {len(full)}/{len(seeds)} states")
+        what = ("the matrix's diagonal 4/4" if len(gaits) == 4 and not a.gains
+                and a.friction == 1.0 and not push else f"{len(gaits)}/{len(gaits)} presets")
+        print(f"every preset its own gait ({what}) from {len(full)}/{len(seeds)} states")
 
 
 if __name__ == "__main__":

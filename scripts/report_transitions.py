@@ -24,11 +24,11 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from cpgbiped.envs.experiments.transition import IN_FAMILY
+
 GAITS = ("walk", "run", "jump", "hop")
-from cpgbiped.envs.experiments.transition import IN_FAMILY  # noqa: E402
-
-
-AT_S = (8.0, 9.0, 10.0, 11.0, 12.0, 13.0, 14.0)  # times of the change for the in-family steps
+AT_S = (8.0, 9.0, 10.0, 11.0, 12.0, 13.0, 14.0)  # times of the change (the first: every pair;
+# all of them: the in-family steps and ramps and every cross-family way)
 PASS_CYCLES = 4  # issue 22: B within 4 CPG cycles of the change
 
 

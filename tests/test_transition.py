@@ -14,7 +14,7 @@ from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import build
 from cpgbiped.envs.simulation.rollout import rollout
 from cpgbiped.envs.experiments.sweep import PERSIST, _first_run, schedule
-from cpgbiped.envs.experiments.transition import transition
+from cpgbiped.envs.experiments.transition import IN_FAMILY, transition
 
 
 def _cli(*args, timeout=300):
@@ -58,16 +58,20 @@ def test_the_cpg_state_carries_across_a_step(K):
     assert dv[k - 3:k + 3].max() <= dv.max() and dv[k - 3:k + 3].max() < 3 * np.percentile(dv, 99)
 
 
-def test_the_window_before_the_change_is_the_last_five_whole_cycles_of_a():
-    """The gait before the change is measured over A's last 5 CPG cycles (the run's Table 2
-    period, 8.868 model units at 12.3 units/s: 0.721 s), not over the body's start-up; the
-    stretch from the settling on is kept beside it."""
+def test_the_window_before_the_change_holds_whole_cycles_of_a():
+    """The gait before the change is measured over whole CPG cycles of A ending at the change:
+    5 of them when they fit after the 2 s settling, else as many as fit. Checked against the
+    body's own strides: the run's window, 5 of the network's cycles, holds 5 of the contacts'
+    stride periods (one stride per CPG cycle)."""
+    from cpgbiped.envs.experiments.transition import before_cycles
+
     res, *_ = transition("ml", "run", "walk", 8.0, 0.0, 9.0)
-    assert res["before"]["start_s"] == pytest.approx(8.0 - 5 * 8.868 / 12.3, abs=0.01)
-    assert res["before"]["end_s"] == res["before_from_settling"]["end_s"] == 8.0
+    w = res["before"]
+    assert res["before_cycles"] == 5
+    assert w["end_s"] - w["start_s"] == pytest.approx(5 * w["stride_period_s"], rel=0.02)
     assert res["before_from_settling"]["start_s"] == 2.0
-    early, *_ = transition("ml", "run", "walk", 4.0, 0.0, 5.0)  # 5 cycles reach the settling
-    assert early["before"]["start_s"] == 2.0
+    assert before_cycles(4.0, 0.721) == 2 and before_cycles(2.5, 0.721) == 0
+    assert before_cycles(100.0, 0.721) == 5
 
 
 def test_transition_json_and_pictures(tmp_path):
@@ -135,8 +139,8 @@ def test_sweep_cli_writes_its_json_and_picture(tmp_path):
 # One protocol, the change at 8 s, open loop and with the recommended feedback gain (the issue
 # asks for both); the time was never chosen for a passing case (README: 8-14 s, measured).
 K_FB = RECOMMENDED["ml"]
-IN_FAMILY_PAIRS = (("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump"))
-IN_FAMILY = [(a, b, r, k) for a, b in IN_FAMILY_PAIRS for r in (0.0, 2.0) for k in (0.0, K_FB)]
+IN_FAMILY_CASES = [(a, b, r, k) for a, b in sorted(IN_FAMILY) for r in (0.0, 2.0)
+                   for k in (0.0, K_FB)]
 IN_FAMILY_SHORTFALL = {
     ("walk", "run", 2.0, 0.0): "a run after the change, no fall, but 12 CPG cycles after it "
                                "(4 asked)",
@@ -165,7 +169,7 @@ IN_FAMILY_SHORTFALL = {
         raises=AssertionError, strict=True,
         reason=f"measured: {IN_FAMILY_SHORTFALL[a, b, r, k]}")]
         if (a, b, r, k) in IN_FAMILY_SHORTFALL else [])
-    for a, b, r, k in IN_FAMILY])
+    for a, b, r, k in IN_FAMILY_CASES])
 def test_in_family_transition(a, b, ramp, k):
     _assert_issue_22_passes("ml", a, b, ramp, k)
 
@@ -173,7 +177,9 @@ def test_in_family_transition(a, b, ramp, k):
 def _assert_issue_22_passes(kind, a, b, ramp, k=0.0):
     """Issue 22: no fall; the physical gait before the change is A; after it, B within 4 CPG
     cycles of the change (at 8 s)."""
-    res, *_ = transition(kind, a, b, 8.0, ramp, 8.0 + ramp + 12.0, feedback=k)
+    from cpgbiped.envs.experiments.transition import default_seconds
+
+    res, *_ = transition(kind, a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp), feedback=k)
     assert not res["fell"], res["fell_at_s"]
     assert res["before"]["physical_gait"] == a, res["before"]["physical_gait"]
     assert res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4, res["windows"]
@@ -185,7 +191,7 @@ def _assert_issue_22_passes(kind, a, b, ramp, k=0.0):
 # model units, 24 s, to lock to the other family's pattern). A pair is reached when one way
 # ends in the target's physical gait without a fall.
 CROSS = [(a, b) for a in ("walk", "run", "jump", "hop") for b in ("walk", "run", "jump", "hop")
-         if a != b and (a, b) not in IN_FAMILY_PAIRS]
+         if a != b and (a, b) not in IN_FAMILY]
 CROSS_SHORTFALL = {
     ("walk", "jump"): "falls 1.1-2.5 s after the change (at 9.1-10.5 s), all four ways",
     ("run", "jump"): "falls 1.4-2.6 s after the change (at 9.4-10.6 s), all four ways",
@@ -206,16 +212,22 @@ def test_cross_family_pair_is_reached_in_one_of_four_ways(a, b):
             res, *_ = transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
                                  feedback=k)
             outcomes.append((ramp, k, res["fell_at_s"], res["after"]["physical_gait"]))
-            if not res["fell"] and res["after"]["physical_gait"] == b:
+            if (not res["fell"] and res["after"]["physical_gait"] == b
+                    and res["cycles_to_switch"] is not None):
                 return
     raise AssertionError(outcomes)
 
 
-def test_the_default_rollout_is_longer_across_the_families():
+def test_the_default_rollout_across_the_families_covers_the_network_s_lock_time():
+    """Issue 22: the network alone takes up to 300 model units to lock to a new pattern; at
+    12.3 units/s, plus a settled window of 3 cycles and one more of the slowest target (the
+    walk, 13.113 units, Table 2 as reproduced), that is 28.7 s after the change."""
     from cpgbiped.envs.experiments.transition import default_seconds
 
-    assert default_seconds("walk", "run", 8.0, 2.0) == 22.0
-    assert default_seconds("hop", "walk", 8.0, 0.0) == 38.0
+    need = 300 / 12.3 + (3 + 1) * 13.113 / 12.3
+    for a, b in (("hop", "walk"), ("jump", "run"), ("walk", "hop")):
+        assert default_seconds(a, b, 8.0, 2.0) - 10.0 >= need
+    assert default_seconds("walk", "run", 8.0, 2.0) < default_seconds("walk", "hop", 8.0, 2.0)
 
 
 def test_extensor_synchrony_is_zero_for_alternating_and_one_for_in_phase_bursts():

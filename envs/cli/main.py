@@ -765,9 +765,8 @@ def cmd_phase_response(a) -> int:
 def cmd_transition(a) -> int:
     from cpgbiped.cpg import io
     from cpgbiped.envs.media.render import check_backend, check_video_size, gait_diagram, render_video
-    from cpgbiped.envs.experiments.transition import (BEFORE_CYCLES, WINDOW_CYCLES,
-                                                      check_transition, default_seconds,
-                                                      transition)
+    from cpgbiped.envs.experiments.transition import (WINDOW_CYCLES, check_transition,
+                                                      default_seconds, transition)
 
     seconds = (a.seconds if a.seconds is not None
                else default_seconds(getattr(a, "from"), a.to, a.at, a.ramp))
@@ -803,8 +802,10 @@ def cmd_transition(a) -> int:
         b, f = res["before"], res["after"]
         print(label)
         w = res["before_from_settling"]
-        print(f"  before ({b['start_s']:.2f}-{b['end_s']:g} s, its last {BEFORE_CYCLES} CPG "
-              f"cycles): physical {b['physical_gait']}, CPG {b['cpg_gait']}, "
+        n = res["before_cycles"]
+        print(f"  before ({b['start_s']:.2f}-{b['end_s']:g} s, "
+              + (f"its last {n} whole CPG cycles" if n else "less than a CPG cycle")
+              + f"): physical {b['physical_gait']}, CPG {b['cpg_gait']}, "
               f"{b['speed_mps']:.2f} m/s (from {w['start_s']:g} s: physical "
               f"{w['physical_gait']})")
         print(f"  after  ({f['start_s']:.2f}-{f['end_s']:g} s): physical {f['physical_gait']}, "

@@ -6,11 +6,12 @@ over ``ramp_s`` seconds (:class:`cpg.integrate.Schedule`). The CPG's state carri
 change; nothing is reset, and the controller is not told (it never sees a name).
 
 Windows, all measured from the foot contacts (:func:`cpgbiped.envs.gaits.validate.measure_recording`):
-- **before**: the last ``BEFORE_CYCLES`` whole CPG cycles of A before the change (from the
-  end of the settling window if the change comes sooner): the gait the body is in when the
-  change comes, so that the body's start-up (the controller's start-up gains hand over with
-  a time constant of 1.5 s) is not counted as the gait before the change. Whole cycles, as
-  a duty factor over part of a stride is biased by the part. ``before_from_settling``: the whole stretch from the end of the
+- **before**: the last ``BEFORE_CYCLES`` whole CPG cycles of A before the change (fewer,
+  ``before_cycles``, when the change comes sooner after the settling): the gait the body is
+  in when the change comes, over whole cycles ending at the change, because a duty factor
+  over part of a stride is biased by the part. It holds less of the body's start-up than the
+  stretch from the settling (the start-up gains hand over with a time constant of 1.5 s;
+  at 2.67 s, where the walk's 5 cycles before an 8 s change begin, 17% of them remain). ``before_from_settling``: the whole stretch from the end of the
   settling window to the change (what ``before`` was until 2026-12-03);
 - **sliding**: ``WINDOW_CYCLES`` CPG cycles of B starting 0, 1, 2, ... cycles after the change
   began, while such a window fits in the rollout;
@@ -98,6 +99,13 @@ def window_summary(net, rec, t0, t1, fell_at):
                                           "end_s": float(rec.t[-1] if t1 is None else t1)}
 
 
+def before_cycles(at_s: float, period_s: float) -> int:
+    """Whole CPG cycles of A in the window before a change at ``at_s``: BEFORE_CYCLES, or as
+    many as fit between the end of the settling and the change (0: the window is the part of
+    a cycle there is)."""
+    return int(min(BEFORE_CYCLES, np.floor((at_s - SETTLE_S) / period_s + 1e-9)))
+
+
 def extensor_synchrony(t_s, activation, at_s: float, period_s: float,
                        n: int = SYNC_CYCLES) -> list:
     """Per cycle k = 0..n-1 of [at_s + k T, at_s + (k + 1) T]: time with both extensors (cells
@@ -124,8 +132,9 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
                   stop_on_fall=False, feedback=feedback)
     fell_at = rec.fell_at
     T = to.period_s()
-    before = window_summary(net, rec, max(SETTLE_S, at_s - BEFORE_CYCLES * net.period_s()),
-                            at_s, fell_at)
+    n_before = before_cycles(at_s, net.period_s())
+    before = window_summary(net, rec, at_s - n_before * net.period_s() if n_before
+                            else SETTLE_S, at_s, fell_at)
     from_settling = window_summary(net, rec, SETTLE_S, at_s, fell_at)
     slides = []
     k = 0
@@ -143,7 +152,8 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
     after = window_summary(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
     res = {"network": kind, "from": a, "to": b, "at_s": float(at_s), "ramp_s": float(ramp_s),
            "seconds": seconds, "feedback_gain": rec.feedback_gain, "cpg_period_to_s": T,
-           "before": before, "before_from_settling": from_settling, "after": after,
+           "before": before, "before_cycles": n_before,
+           "before_from_settling": from_settling, "after": after,
            "fell": fell_at is not None,
            "fell_at_s": fell_at,
            "settled_after_cycles": settled,
