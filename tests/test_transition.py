@@ -189,7 +189,7 @@ def _assert_issue_22_passes(kind, a, b, ramp, k=0.0):
 # pair run the four ways (step or 2 s ramp, open loop or the recommended feedback) for the
 # command line's default length (30 s after the change: the network alone takes up to 300
 # model units, 24 s, to lock to the other family's pattern). A pair is reached when one way
-# ends in the target's physical gait without a fall.
+# settles in the target's physical gait without a fall (cycles_to_switch is set).
 CROSS = [(a, b) for a in ("walk", "run", "jump", "hop") for b in ("walk", "run", "jump", "hop")
          if a != b and (a, b) not in IN_FAMILY]
 CROSS_SHORTFALL = {
@@ -212,8 +212,7 @@ def test_cross_family_pair_is_reached_in_one_of_four_ways(a, b):
             res, *_ = transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
                                  feedback=k)
             outcomes.append((ramp, k, res["fell_at_s"], res["after"]["physical_gait"]))
-            if (not res["fell"] and res["after"]["physical_gait"] == b
-                    and res["cycles_to_switch"] is not None):
+            if res["cycles_to_switch"] is not None:  # B settled, no fall
                 return
     raise AssertionError(outcomes)
 

@@ -11,8 +11,9 @@ Windows, all measured from the foot contacts (:func:`cpgbiped.envs.gaits.validat
   in when the change comes, over whole cycles ending at the change, because a duty factor
   over part of a stride is biased by the part. It holds less of the body's start-up than the
   stretch from the settling (the start-up gains hand over with a time constant of 1.5 s;
-  at 2.67 s, where the walk's 5 cycles before an 8 s change begin, 17% of them remain). ``before_from_settling``: the whole stretch from the end of the
-  settling window to the change (what ``before`` was until 2026-12-03);
+  at 2.67 s, where the walk's 5 cycles before an 8 s change begin, 17% of them remain).
+  ``before_from_settling``: the whole stretch from the end of the settling window to the
+  change (what ``before`` was until 2026-12-03);
 - **sliding**: ``WINDOW_CYCLES`` CPG cycles of B starting 0, 1, 2, ... cycles after the change
   began, while such a window fits in the rollout;
 - **after**: from the first sliding window from which every later one names the same physical
@@ -133,9 +134,9 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
     fell_at = rec.fell_at
     T = to.period_s()
     n_before = before_cycles(at_s, net.period_s())
-    before = window_summary(net, rec, at_s - n_before * net.period_s() if n_before
-                            else SETTLE_S, at_s, fell_at)
     from_settling = window_summary(net, rec, SETTLE_S, at_s, fell_at)
+    before = (window_summary(net, rec, at_s - n_before * net.period_s(), at_s, fell_at)
+              if n_before else from_settling)
     slides = []
     k = 0
     while at_s + (k + WINDOW_CYCLES) * T <= rec.t[-1] + 1e-9:
