@@ -322,6 +322,41 @@ def test_check_secondary_runs_each_weight_set_through_the_body(tmp_path):
     assert {"physical_gait", "fell", "duty_factor", "lr_phase_lag"} <= set(row)
 
 
+def test_check_secondary_draws_every_rollout_with_out(tmp_path):
+    """--out: the results as JSON and, for each weight set, a chronophotograph of its rollout,
+    all of them in one panel (two per row, the widest scaled to the panel's column)."""
+    from PIL import Image
+
+    from cpgbiped.envs.experiments.secondary_check import PANEL_WIDTH_PX
+
+    (tmp_path / "hop").mkdir()
+    hop = json.loads(_secondary_file(tmp_path / "hop", target="asymmetric_hop",
+                                     source="hop").read_text())["targets"][0]
+    path = _secondary_file(tmp_path)
+    data = json.loads(path.read_text())
+    data["targets"].append(hop)
+    path.write_text(json.dumps(data))
+    out = tmp_path / "check"
+    r = _cli("check-secondary", str(path), "--seconds", "3", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    res = json.loads((out / "check_secondary.json").read_text())
+    assert set(res) == {"skip", "asymmetric_hop"}
+    for stem in ("skip_from_walk", "asymmetric_hop_from_hop"):
+        with Image.open(out / f"{stem}_chrono.png") as im:
+            assert im.format == "PNG" and im.width > 300 and im.height > 300
+    with Image.open(out / "secondary_chrono.png") as im:
+        assert im.width == 2 * PANEL_WIDTH_PX  # two panels side by side
+
+
+def test_check_secondary_out_is_all_or_nothing(tmp_path):
+    """A malformed file with --out: the one-line error, and no folder."""
+    out = tmp_path / "check"
+    r = _cli("check-secondary", str(_secondary_file(tmp_path, phi=-1.0)), "--out", str(out),
+             timeout=60)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("change,says", [
     ({"source": "gallop"}, "at targets/0/source"),
     ({"i_app": "0.2"}, "at targets/0/i_app"),

@@ -866,8 +866,18 @@ def cmd_check_secondary(a) -> int:
     from cpgbiped.envs.experiments.secondary_check import check_secondary, load_secondary, table
 
     check_workers(a)
+    if a.out is not None:
+        out_dir(a.out)
     n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
-    res = check_secondary(a.secondary, a.seconds, a.workers)
+    if a.out is None:
+        res = check_secondary(a.secondary, a.seconds, a.workers)
+    else:
+        from cpgbiped.cpg.outdir import ResultDir
+
+        with ResultDir(a.out) as rd:  # the table and every picture land together
+            res = check_secondary(a.secondary, a.seconds, a.workers, img_dir=rd.staging)
+            io.write_json(rd.path("check_secondary.json"), res)
+            rd.commit()
     if a.json:
         print(io.to_json(res))
     else:
@@ -876,6 +886,10 @@ def cmd_check_secondary(a) -> int:
         print(table(res))
         print(f"{sum(r['confirmed'] for r in res.values())} confirmed in the body (both "
               f"classifiers name the target, no fall)")
+        if a.out is not None:
+            print(f"wrote {a.out}/check_secondary.json, a chronophotograph per weight set "
+                  f"(<target>_from_<source>_chrono.png) and all of them in "
+                  f"{a.out}/secondary_chrono.png")
     return 0
 
 
@@ -1080,11 +1094,17 @@ def build_parser() -> argparse.ArgumentParser:
         12 directed weights with I_app and phi, from the Table 3 state of the gait they were
         broken from, drive the body through the one controller. Prints the gait the CPG
         classifier names and the physical gait (primary patterns, then skip, gallop,
-        hesitation walk, asymmetric hop, one-legged hop from the contacts alone).""")
+        hesitation walk, asymmetric hop, one-legged hop from the contacts alone). With
+        --out DIR, all or nothing: DIR/check_secondary.json, a chronophotograph of each
+        rollout (<target>_from_<source>_chrono.png: two strides' poses and the footfalls,
+        up to a fall) and all of them in one picture, DIR/secondary_chrono.png.""")
     sp.add_argument("secondary", metavar="SECONDARY.json", help="cpgbiped secondary's result")
     sp.add_argument("--seconds", type=seconds_arg, default=20.0,
                     help="simulated seconds after 2 s of settling (default 20)")
     sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
+    sp.add_argument("--out", metavar="DIR", default=None,
+                    help="also write DIR/check_secondary.json, a chronophotograph of each "
+                         "rollout and all of them in DIR/secondary_chrono.png")
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("check-pareto", cmd_check_pareto, "run an optimiser result's Pareto points in physics",

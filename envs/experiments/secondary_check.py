@@ -7,6 +7,12 @@ the primary gait it was broken from. It drives the body for ``seconds`` after th
 window; the CPG classifier names the gait of the cells, the contact classifier (primary
 patterns, then the secondary ones of :data:`cpgbiped.envs.gaits.criteria.SECONDARY_PATTERNS`) the gait of the
 body. A target is confirmed physically when both name it and the body does not fall.
+
+With an output folder (``cpgbiped check-secondary ... --out DIR``), each rollout is also
+drawn: a chronophotograph of its last two strides before the end of the window or the fall
+(``<target>_from_<source>_chrono.png``, :mod:`cpgbiped.envs.media.chrono`, with the footfall
+strip), and all of them in one picture, ``secondary_chrono.png``, one panel per weight set in
+the file's order, so that what the body does with each secondary rhythm can be seen.
 """
 from __future__ import annotations
 
@@ -38,8 +44,13 @@ def load_secondary(path) -> list[dict]:
     return out
 
 
+def picture_stem(t: dict) -> str:
+    """File stem of one weight set's pictures: ``<target>_from_<source>``."""
+    return f"{t['target']}_from_{t['source']}"
+
+
 def _one(args):
-    t, seconds = args
+    t, seconds, img_dir = args
     from cpgbiped.cpg.network import build
 
     from cpgbiped.envs.gaits.validate import validate
@@ -50,16 +61,27 @@ def _one(args):
     except InputError as e:
         return {"source": t["source"], "found_in_network": t["found"], "error": str(e),
                 "cpg_gait": "none", "physical_gait": "none", "fell": None, "confirmed": False}
-    s = validate(net, None, seconds).summary()
+    v = validate(net, None, seconds)
+    s = v.summary()
     row = {"source": t["source"], "found_in_network": t["found"], **{k: s[k] for k in KEYS}}
     row["confirmed"] = bool(s["cpg_gait"] == t["target"] == s["physical_gait"] and not s["fell"])
+    if img_dir is not None:
+        from cpgbiped.envs.media.chrono import chrono_title, chronophotograph
+
+        label = (f"{t['target'].replace('_', ' ')} from the {t['source']} (CPG: "
+                 f"{s['cpg_gait'].replace('_', ' ')})")
+        period = s["cpg_period_s"] if s.get("cpg_period_s") else None
+        chronophotograph(v.recording, Path(img_dir) / f"{picture_stem(t)}_chrono.png",
+                         v.metrics, chrono_title(label, v), period_s=period)
     return row
 
 
-def check_secondary(path, seconds: float = 20.0, workers: int = 2) -> dict:
-    """{"<target> from <source>": {cpg_gait, physical_gait, fell, confirmed, metrics}}."""
+def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None) -> dict:
+    """{"<target> from <source>": {cpg_gait, physical_gait, fell, confirmed, metrics}};
+    with ``img_dir`` (an existing folder) each rollout's chronophotograph is written there
+    and the panel of all of them, :func:`montage`."""
     targets = load_secondary(path)
-    jobs = [(t, seconds) for t in targets]
+    jobs = [(t, seconds, None if img_dir is None else str(img_dir)) for t in targets]
     if workers > 1 and len(jobs) > 1:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
@@ -75,7 +97,44 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2) -> dict:
     out = {}
     for t, r in zip(targets, rows):  # a target found twice: the second named by its source
         out[t["target"] if t["target"] not in out else f"{t['target']} from {t['source']}"] = r
+    if img_dir is not None:
+        pics = [Path(img_dir) / f"{picture_stem(t)}_chrono.png" for t in targets]
+        montage([p for p in pics if p.exists()], Path(img_dir) / "secondary_chrono.png")
     return out
+
+
+PANEL_WIDTH_PX = 1000  # the widest chronophotograph's width in the panel
+
+
+def montage(paths, out, columns: int = 2) -> Path:
+    """The pictures ``paths`` in one PNG, ``columns`` per row in their order, all scaled by
+    one factor (the widest to PANEL_WIDTH_PX, so that their lettering stays alike), each
+    centred in its cell (white background)."""
+    from PIL import Image
+
+    from cpgbiped.cpg.io import atomic_path
+
+    ims = []
+    for p in paths:
+        with Image.open(p) as im:
+            ims.append(im.convert("RGB"))
+    if not ims:
+        raise ValueError("no pictures to put in a panel")
+    k = PANEL_WIDTH_PX / max(im.width for im in ims)
+    ims = [im.resize((max(1, round(im.width * k)), max(1, round(im.height * k))), Image.LANCZOS)
+           for im in ims]
+    rows = [ims[j:j + columns] for j in range(0, len(ims), columns)]
+    heights = [max(im.height for im in r) for r in rows]
+    sheet = Image.new("RGB", (PANEL_WIDTH_PX * min(columns, len(ims)), sum(heights)), "white")
+    y = 0
+    for r, h in zip(rows, heights):
+        for c, im in enumerate(r):
+            sheet.paste(im, (c * PANEL_WIDTH_PX + (PANEL_WIDTH_PX - im.width) // 2,
+                             y + (h - im.height) // 2))
+        y += h
+    with atomic_path(out, suffix=".png") as tmp:  # line art: 256 colours hold it, at a fifth
+        sheet.quantize(colors=256).save(tmp, format="png", optimize=True)
+    return Path(out)
 
 
 def table(res: dict) -> str:
