@@ -7,7 +7,9 @@
 - :class:`SymmetryBreakingProblem`: from a primary gait's optimum, perturbations of the 12
   directed weights that keep exactly one reflection of the square network (the H symmetry
   the target needs) and break the other two; objectives from the target's row of the gait
-  table (see :mod:`cpg.evaluate`).
+  table (see :mod:`cpg.evaluate`), and optionally a fourth: how far the left-right lag of
+  the extensors is from a target lag (:func:`extensor_lag`), for secondary gaits whose body
+  is told apart by that lag (``cpgbiped secondary --physics``).
 - :func:`run`: NSGA-II with checkpoints (the pickled algorithm holds pymoo's random
   generator, so a resumed run continues bit for bit) and an optional Dask evaluator.
 
@@ -30,7 +32,7 @@ from pymoo.core.problem import Problem
 
 from . import morris_lecar as ml
 from .errors import InputError
-from .evaluate import Evaluation, SimSettings, evaluate, with_robustness
+from .evaluate import WORST_DEG, Evaluation, SimSettings, evaluate, with_robustness
 from .gaits import GAITS, PRIMARY, gait as gait_entry
 from .io import atomic_path
 
@@ -145,15 +147,29 @@ class PrimaryGaitProblem(_BatchedProblem):
         return ml.weight_matrix(X)
 
 
+def extensor_lag(phases_deg: np.ndarray) -> np.ndarray:
+    """The left-right lag of the extensors, LE to RE, as a circular distance from 0 in cycles:
+    0 when they burst together, 0.5 when they alternate; NaN where the phases are undefined.
+    ``phases_deg`` (B, 4): the cells' phases vs LF (:class:`cpg.evaluate.Evaluation`)."""
+    ph = np.asarray(phases_deg, dtype=float)
+    lag = np.mod((ph[:, 3] - ph[:, 2]) / 360.0, 1.0)
+    return np.minimum(lag, 1.0 - lag)
+
+
 class SymmetryBreakingProblem(_BatchedProblem):
     """Perturbations d of a base network that keep one reflection: W = W_base + expand(d).
 
     Variables: one value per orbit of directed weights under the kept reflection, in
     [-radius, radius]. The base network is the source gait's weights with its (I_app, phi).
+    With ``target_lag`` (cycles, in [0, 0.5]) a fourth objective, 360 |lag - target_lag|
+    degrees with lag = :func:`extensor_lag` (180, the worst, where it is undefined): the
+    paper's secondary patterns fix which cells share a waveform, not the lag between the two
+    waveforms, which is what tells a gallop from a hop or a run in the body.
     """
 
     def __init__(self, target: str, source: str, keep: str, base_weights, radius: float = 1.0,
-                 settings: SimSettings = SimSettings(), evaluator=None):
+                 settings: SimSettings = SimSettings(), evaluator=None,
+                 target_lag: float | None = None):
         g = gait_entry(target)
         if g.primary:
             raise InputError(f"{g.name} is a primary gait: use the primary search")
@@ -165,7 +181,25 @@ class SymmetryBreakingProblem(_BatchedProblem):
         self.base = ml.weight_matrix(np.asarray(base_weights, dtype=float))
         self.groups = orbits(keep)
         self.settings = settings
+        if target_lag is not None and not (np.isfinite(target_lag) and 0 <= target_lag <= 0.5):
+            raise InputError(f"the target lag must be in [0, 0.5] cycles, got {target_lag}")
+        self.target_lag = None if target_lag is None else float(target_lag)
         super().__init__(len(self.groups), -radius, radius, evaluator)
+        if self.target_lag is not None:
+            self.n_obj += 1
+
+    @property
+    def objective_names(self) -> list[str]:
+        return super().objective_names + (["lag_error"] if self.target_lag is not None else [])
+
+    def resume_key(self):  # a checkpoint resumes only the same target lag
+        return {"target_lag": self.target_lag}
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        super()._evaluate(X, out, *args, **kwargs)
+        if self.target_lag is not None:
+            err = 360.0 * np.abs(extensor_lag(self.last.phases_deg) - self.target_lag)
+            out["F"] = np.column_stack([out["F"], np.where(np.isfinite(err), err, WORST_DEG)])
 
     def directed(self, X: np.ndarray) -> np.ndarray:
         """The 12 directed weights (B, 12) of perturbations X (B, n_orbits)."""

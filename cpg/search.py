@@ -22,7 +22,7 @@ from .io import atomic_path, write_json, write_text
 from .outdir import ResultDir
 from .results import FORMAT, SECONDARY_FORMAT, load_result  # noqa: F401 (re-exported)
 from .optimize import (SECONDARY_TARGETS, PrimaryGaitProblem, RunSettings,
-                       SymmetryBreakingProblem, run)
+                       SymmetryBreakingProblem, extensor_lag, run)
 
 TIE_DEG = 0.01
 N_TIE_CANDIDATES = 8
@@ -175,29 +175,65 @@ def _optimize_primary(rd: ResultDir, gait, rs, lo, hi, settings, evaluator, prog
 
 
 # ------------------------------------------------------------------------------ secondary
+LAG_MATCH = 0.03  # cycles: a candidate's extensor lag this close to the target lag counts
+
+
 def secondary_search(target: str, source: str, keep: str, base_weights, rs: RunSettings,
                      settings: SimSettings = SimSettings(), radius: float = 1.0,
-                     evaluator=None, progress=None, n_confirm: int = 10) -> dict:
-    """Search one symmetry-breaking target; confirm the best point with the classifier."""
+                     evaluator=None, progress=None, n_confirm: int = 10,
+                     target_lag: float | None = None, candidates: bool = False) -> dict:
+    """Search one symmetry-breaking target; confirm the best point with the classifier.
+
+    ``target_lag``: also pull the extensors' left-right lag towards it (cycles; a fourth
+    objective, :class:`SymmetryBreakingProblem`). ``candidates``: also list every Pareto
+    point that the classifier names the target from the Table 3 state (and, with a target
+    lag, whose lag is within LAG_MATCH of it), as {"directed_weights" (12), "objectives",
+    "extensor_lag"}: what ``cpgbiped secondary --physics`` puts through the body."""
     problem = SymmetryBreakingProblem(target, source, keep, base_weights, radius, settings,
-                                      evaluator)
+                                      evaluator, target_lag=target_lag)
     res = run(problem, rs, on_generation=progress)
     F = res.pareto_F
     best = int(np.argmin(F.sum(axis=1)))
-    w12 = problem.directed(res.pareto_X[best])[0]
-    W = ml.directed_matrix(w12)
+    out = secondary_point(problem, base_weights, problem.directed(res.pareto_X[best])[0],
+                          F[best], rs, settings, n_confirm)
+    if candidates:
+        W = problem.directed(res.pareto_X)
+        ev = evaluate(target, problem.i_app, problem.phi, ml.directed_matrix(W),
+                      np.repeat(problem.y0[None], len(W), axis=0), settings)
+        lag = extensor_lag(ev.phases_deg)
+        out["candidates"] = [
+            {"directed_weights": W[k].tolist(), "objectives": F[k].tolist(),
+             "extensor_lag": float(lag[k])}
+            for k in range(len(W)) if ev.classified[k] == target
+            and (target_lag is None or abs(lag[k] - target_lag) <= LAG_MATCH)]
+    return out
+
+
+def secondary_point(problem: SymmetryBreakingProblem, base_weights, w12, objectives,
+                    rs: RunSettings, settings: SimSettings = SimSettings(),
+                    n_confirm: int = 10) -> dict:
+    """The result entry of one weight set of a symmetry-breaking search: its 12 directed
+    weights, objectives, the class the classifier gives it from the Table 3 state, and the
+    fraction of ``n_confirm`` random states (seed ``rs.seed + 3``) from which it is named the
+    target; "found" when both hold (the target from the Table 3 state, >= 80%).
+    ``base_weights``: the source gait's weights the search started from, as given."""
+    target = problem.gait
+    W = ml.directed_matrix(np.asarray(w12, dtype=float))
     y0 = np.vstack([problem.y0, ml.random_states(n_confirm, rs.seed + 3)])
     ev = evaluate(target, problem.i_app, problem.phi, np.repeat(W[None], len(y0), 0), y0, settings)
     confirmed = float(np.mean([c == target for c in ev.classified]))
+    names = ["phase error of same-wave pairs (deg)",
+             "180 x waveform distance of same-wave pairs",
+             "180 x shortfall of distinctness of y1/y2 pairs"]
+    if problem.target_lag is not None:
+        names.append(f"360 x |extensor lag - {problem.target_lag:g}| (deg)")
     return {
-        "target": target, "source": source, "kept_symmetry": keep,
+        "target": target, "source": problem.source, "kept_symmetry": problem.keep,
         "i_app": problem.i_app, "phi": problem.phi,
         "base_weights": list(map(float, base_weights)),
-        "directed_weights": dict(zip(ml.DIRECTED_NAMES, np.round(w12, 6).tolist())),
-        "objectives": np.round(F[best], 4).tolist(),
-        "objective_names": ["phase error of same-wave pairs (deg)",
-                            "180 x waveform distance of same-wave pairs",
-                            "180 x shortfall of distinctness of y1/y2 pairs"],
+        "directed_weights": dict(zip(ml.DIRECTED_NAMES, np.round(np.asarray(w12, float), 6).tolist())),
+        "objectives": np.round(np.asarray(objectives, float), 4).tolist(),
+        "objective_names": names,
         "classified_from_table3_state": ev.classified[0],
         "confirmed_fraction": confirmed,
         "found": bool(ev.classified[0] == target and confirmed >= 0.8),
@@ -233,14 +269,34 @@ def comparison_markdown(primary: dict[str, dict], secondary: list[dict] | None) 
         lines += ["", "## Secondary gaits by symmetry breaking", "",
                   "| target | from | kept symmetry | paper reached | found here | confirmed "
                   "from random states | objectives |", "|---|---|---|---|---|---|---|"]
+        body = any("physics" in s for s in secondary)
+        if body:  # cpgbiped secondary --physics: the body chose among the candidates
+            lines[-2] += " target lag | body, selection states |"
+            lines[-1] += "---|---|"
         for s in secondary:
-            lines.append(f"| {s['target']} | {s['source']} | {s['kept_symmetry']} | "
-                         f"{'yes' if s['paper_reached'] else 'no'} | "
-                         f"{'yes' if s['found'] else 'no'} | {s['confirmed_fraction']:.0%} | "
-                         f"{f(s['objectives'])} |")
+            row = (f"| {s['target']} | {s['source']} | {s['kept_symmetry']} | "
+                   f"{'yes' if s['paper_reached'] else 'no'} | "
+                   f"{'yes' if s['found'] else 'no'} | {s['confirmed_fraction']:.0%} | "
+                   f"{f(s['objectives'])} |")
+            if body:
+                ph = s.get("physics", {})
+                lag = ph.get("target_lag")
+                row += (f" {'-' if lag is None else f'{lag:g}'} | "
+                        + (f"{ph['confirmed_states']} of {len(ph['states'])} confirmed, "
+                           f"{ph['falls']} falls ({ph['candidates']} candidates) |"
+                           if ph.get("candidates") else "no candidate |"))
+            lines.append(row)
+        if body:
+            lines += ["", "Body, selection states: in how many of the random CPG states the "
+                      "body was driven from (seeds in secondary.json, never the Table 3 "
+                      "state) both classifiers name the target without a fall."]
     return "\n".join(lines) + "\n"
 
 
-def write_secondary(path: str | Path, results: list[dict]) -> Path:
-    """The secondary-gait results file (``path``: the file, e.g. DIR/secondary.json)."""
-    return write_json(path, {"format": SECONDARY_FORMAT, "targets": results})
+def write_secondary(path: str | Path, results: list[dict], command: str | None = None) -> Path:
+    """The secondary-gait results file (``path``: the file, e.g. DIR/secondary.json), with the
+    command that made it when given."""
+    data = {"format": SECONDARY_FORMAT, "targets": results}
+    if command is not None:
+        data["command"] = command
+    return write_json(path, data)

@@ -36,3 +36,93 @@ def test_found_targets_reconfirmed_from_new_random_states(results):
                             SimSettings(t_end=600.0, t_settle=400.0, dt=0.02, record_every=2))
         names = [gaits.classify(tr.t, tr.x[b])[0] for b in range(10)]
         assert names.count(r["target"]) >= 7, f"{r['target']} from {r['source']}: {names}"
+
+
+# -- secondary --physics: the network's candidates chosen by the body ------------------------
+def test_the_lag_objective_measures_the_extensors_lag_of_the_paper_patterns():
+    """The fourth objective, 360 |lag - target| degrees: the paper's jump bursts its extensors
+    together (lag 0), its walk alternates them (lag 0.5); the unperturbed networks give
+    exactly those lags, so the objective is 360 x the target's distance from them."""
+    from cpgbiped.cpg.optimize import SymmetryBreakingProblem
+
+    for source, keep, lag in (("jump", "horizontal", 0.0), ("walk", "horizontal", 0.5)):
+        p = SymmetryBreakingProblem("gallop", source, keep, list(ml.preset(source).weights),
+                                    target_lag=0.2)
+        out = {}
+        p._evaluate(np.zeros((1, p.n_var)), out)
+        assert p.n_obj == 4 and out["F"].shape == (1, 4)
+        assert out["F"][0, 3] == pytest.approx(360 * abs(lag - 0.2), abs=0.5)
+
+
+def test_a_target_lag_outside_half_a_cycle_is_refused():
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.cpg.optimize import SymmetryBreakingProblem
+
+    with pytest.raises(InputError, match="target lag"):
+        SymmetryBreakingProblem("gallop", "walk", "horizontal", list(ml.preset("walk").weights),
+                                target_lag=0.7)
+
+
+def test_candidates_are_named_the_target_at_their_lag():
+    """Every candidate re-simulated from the Table 3 state: the classifier names the target
+    and the extensors' lag (from the phases, computed here) is within LAG_MATCH of the target."""
+    from cpgbiped.cpg.evaluate import evaluate
+    from cpgbiped.cpg.search import LAG_MATCH, secondary_search
+
+    r = secondary_search("gallop", "walk", "horizontal", list(ml.preset("walk").weights),
+                         RunSettings(pop=24, gens=10, seed=0), target_lag=0.3, candidates=True)
+    assert r["candidates"], "no candidate at lag 0.3"
+    W = ml.directed_matrix(np.array([c["directed_weights"] for c in r["candidates"]]))
+    p = ml.preset("walk")
+    ev = evaluate("gallop", p.i_app, p.phi, W, np.repeat(p.y0[None], len(W), 0))
+    assert ev.classified == ["gallop"] * len(W)
+    lag = np.mod((ev.phases_deg[:, 3] - ev.phases_deg[:, 2]) / 360.0, 1.0)
+    assert np.all(np.minimum(lag, 1 - lag) >= 0.3 - LAG_MATCH - 1e-9)
+    assert np.all(np.minimum(lag, 1 - lag) <= 0.3 + LAG_MATCH + 1e-9)
+
+
+def test_target_lags_lie_inside_the_contact_rules():
+    """The grids come from the contact rules' constants: a hesitation walk's touchdowns at
+    least LAG_AWAY from 0 and LAG_UNEQUAL from 0.5, a gallop's LAG_AWAY from both, an
+    asymmetric hop's within LAG_TOGETHER of 0; the skip and the one-legged hop have no lag rule."""
+    from cpgbiped.envs.gaits.criteria import LAG_AWAY, LAG_TOGETHER, LAG_UNEQUAL
+    from cpgbiped.envs.search.secondary_physics import lag_grid
+
+    h, g, a = lag_grid("hesitation_walk"), lag_grid("gallop"), lag_grid("asymmetric_hop")
+    assert min(h) == LAG_AWAY and all(LAG_AWAY <= x <= 0.5 - LAG_UNEQUAL for x in h)
+    assert min(g) == LAG_AWAY and all(LAG_AWAY <= x <= 0.5 - LAG_AWAY for x in g)
+    assert min(a) == 0.0 and all(x <= LAG_TOGETHER for x in a)
+    assert lag_grid("skip") is None and lag_grid("one_legged_hop") is None
+
+
+def test_the_body_chooses_on_states_that_no_test_or_check_uses():
+    """Selection states: random CPG states from seed 1000, never the Table 3 state (which
+    check-secondary judges from), the tests' seeds 10-19 or the census's 3000 and up."""
+    from cpgbiped.envs.search.secondary_physics import MAX_STATES, selection_seeds
+
+    seeds = selection_seeds(MAX_STATES)
+    assert None not in seeds and not set(seeds) & set(range(10, 20))
+    assert max(seeds) < 3000
+
+
+def test_the_body_keeps_the_candidate_it_confirms_most_often(monkeypatch):
+    """A small search of the gallop from the walk: the kept point is a candidate with the most
+    confirmations (then the fewest falls); re-driven from its selection state it gives the
+    recorded gait."""
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.gaits.validate import validate
+    from cpgbiped.envs.search import secondary_physics as sp
+
+    weights = {g: list(ml.preset(g).weights) for g in ml.PRIMARY_GAITS}
+    target = [t for t in SECONDARY_TARGETS if t[:2] == ("gallop", "walk")]
+    monkeypatch.setattr(sp, "lag_grid", lambda name: [0.36])  # one target lag: a small search
+    (r,) = sp.physics_secondary(weights, RunSettings(pop=24, gens=10, seed=0), states=2,
+                                seconds=8.0, workers=1, targets=target)
+    ph = r["physics"]
+    assert ph["candidates"] >= 1 and ph["states"] == [1000, 1001]
+    assert ph["confirmed_states"] == max(ph["confirmed_per_candidate"])
+    w = [r["directed_weights"][n] for n in ml.DIRECTED_NAMES]
+    p = ml.preset("walk")
+    s = validate(build("ml", "walk", weights=w, i_app=p.i_app, phi=p.phi, seed=1000), None,
+                 8.0).summary()
+    assert s["physical_gait"] == ph["physical_gaits"][0]

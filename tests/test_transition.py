@@ -5,6 +5,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -346,6 +347,55 @@ def test_check_secondary_draws_every_rollout_with_out(tmp_path):
             assert im.format == "PNG" and im.width > 300 and im.height > 300
     with Image.open(out / "secondary_chrono.png") as im:
         assert im.width == 2 * PANEL_WIDTH_PX  # two panels side by side
+
+
+def test_check_secondary_counts_random_states(tmp_path):
+    """--states N: every weight set also from N random CPG states, seeds 3000 and up; a
+    weight set that is the walk's own cannot be a skip in any of them."""
+    r = _cli("check-secondary", str(_secondary_file(tmp_path)), "--seconds", "4", "--states",
+             "2", "--json")
+    assert r.returncode == 0, r.stderr
+    rs = json.loads(r.stdout)["skip"]["random_states"]
+    assert rs["seeds"] == [3000, 3001] and rs["confirmed"] == 0
+    assert len(rs["physical_gaits"]) == 2
+    r = _cli("check-secondary", str(_secondary_file(tmp_path)), "--states", "101", timeout=60)
+    assert r.returncode == 2 and "--states must be at most 100" in r.stderr
+
+
+def test_secondary_physics_bounds_its_states(tmp_path):
+    r = _cli("secondary", "--physics", "--states", "33", "--out", str(tmp_path / "s"), timeout=60)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "--states must be at most 32" in r.stderr and not (tmp_path / "s").exists()
+
+
+# The weight sets that `cpgbiped secondary --physics --out out/secondary_physics` (seed 0, the
+# paper's base weights, 6 selection states from CPG seed 1000) chose on 2026-12-04; the
+# command is in the file. The body judges them here from the Table 3 state, which the
+# selection never used.
+PHYSICS_SECONDARY = Path(__file__).parent / "data" / "secondary_physics.json"
+PHYSICS_SHORTFALL = {
+    ("hesitation_walk", "jump"): "named walk from the Table 3 state: touchdown lag 0.59, within the "
+                       "walk's 0.5 +- 0.1 (21 of 30 random states confirm it)",
+}
+
+
+@pytest.mark.parametrize("target,source", [
+    pytest.param(*t, id=f"{t[0]}-from-{t[1]}",
+                 marks=[pytest.mark.xfail(raises=AssertionError, strict=True,
+                                          reason=f"measured: {PHYSICS_SHORTFALL[t]}")]
+                 if t in PHYSICS_SHORTFALL else [])
+    for t in (("gallop", "walk"), ("hesitation_walk", "jump"))])
+def test_a_secondary_gait_chosen_by_the_body_is_confirmed_from_the_table3_state(target, source):
+    """Issue 22: a secondary gait confirmed physically: both classifiers name the target and
+    the body does not fall (the gallop from the walk, the hesitation walk from the jump:
+    the two targets the body confirmed most often in the selection)."""
+    from cpgbiped.envs.experiments.secondary_check import _one, load_secondary
+
+    (t,) = [t for t in load_secondary(PHYSICS_SECONDARY)
+            if (t["target"], t["source"]) == (target, source)]
+    row = _one((t, 20.0, None, None))
+    assert row["confirmed"], (row["cpg_gait"], row["physical_gait"], row["fell"],
+                              row["lr_phase_lag"])
 
 
 def test_check_secondary_out_is_all_or_nothing(tmp_path):

@@ -520,6 +520,10 @@ def cmd_secondary(a) -> int:
     from cpgbiped.cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
     check_workers(a)
+    from cpgbiped.envs.search.secondary_physics import MAX_STATES
+
+    if a.physics and a.states > MAX_STATES:
+        raise _input_error(f"--states must be at most {MAX_STATES}, got {a.states}")
     if a.results is not None and not os.path.isdir(a.results):
         raise _input_error(f"--results {a.results!r} is not a folder of optimiser results")
     a.results = a.results or "out/optimize"
@@ -547,12 +551,27 @@ def cmd_secondary(a) -> int:
                     bar.set_description(f"target {next(target)}/{len(SECONDARY_TARGETS)}")
                 advance(gen, n)
 
-            results = secondary_all(weights, rs, evaluator=ev, progress=prog)
+            if a.physics:
+                from cpgbiped.envs.search.secondary_physics import physics_secondary
+
+                searches = iter(range(1, 10_000))
+
+                def each_search(gen, n):  # one bar, reset for each network search
+                    if gen == 1:
+                        bar.reset(total=n)
+                        bar.set_description(f"network search {next(searches)}, then the body")
+                    advance(gen, n)
+
+                results = physics_secondary(weights, rs, states=a.states, workers=a.workers,
+                                            evaluator=ev, progress=each_search)
+            else:
+                results = secondary_all(weights, rs, evaluator=ev, progress=prog)
             bar.close()
         finally:
             if ev is not None:
                 ev.close()
-        write_secondary(rd.path("secondary.json"), results)
+        write_secondary(rd.path("secondary.json"), results,
+                        command="cpgbiped " + " ".join(shlex.quote(x) for x in a.argv))
         table = comparison_markdown(primary if len(primary) == 4 else {}, results)
         io.write_text(rd.path("comparison.md"), table)
         rd.commit()
@@ -866,23 +885,30 @@ def cmd_check_secondary(a) -> int:
     from cpgbiped.envs.experiments.secondary_check import check_secondary, load_secondary, table
 
     check_workers(a)
+    from cpgbiped.envs.experiments.secondary_check import MAX_STATES
+
+    if a.states > MAX_STATES:
+        raise _input_error(f"--states must be at most {MAX_STATES}, got {a.states}")
     if a.out is not None:
         out_dir(a.out)
     n = len(load_secondary(a.secondary))  # a malformed file fails here, before any work
     if a.out is None:
-        res = check_secondary(a.secondary, a.seconds, a.workers)
+        res = check_secondary(a.secondary, a.seconds, a.workers, states=a.states)
     else:
         from cpgbiped.cpg.outdir import ResultDir
 
         with ResultDir(a.out) as rd:  # the table and every picture land together
-            res = check_secondary(a.secondary, a.seconds, a.workers, img_dir=rd.staging)
+            res = check_secondary(a.secondary, a.seconds, a.workers, img_dir=rd.staging,
+                                  states=a.states)
             io.write_json(rd.path("check_secondary.json"), res)
             rd.commit()
     if a.json:
         print(io.to_json(res))
     else:
         print(f"{n} secondary weight sets of {a.secondary} through the body ({a.seconds:g} s "
-              f"after settling):")
+              f"after settling), from the Table 3 state"
+              + (f" and from {a.states} random CPG states (seeds 3000 and up)" if a.states else "")
+              + ":")
         print(table(res))
         print(f"{sum(r['confirmed'] for r in res.values())} confirmed in the body (both "
               f"classifiers name the target, no fall)")
@@ -1102,6 +1128,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=20.0,
                     help="simulated seconds after 2 s of settling (default 20)")
     sp.add_argument("--workers", type=count_arg(1), default=2, help="parallel processes (default 2)")
+    sp.add_argument("--states", type=count_arg(0), default=0, metavar="N",
+                    help="also drive each weight set from N random initial CPG states (seeds "
+                         "3000 and up, never tuned on) and count the confirmations (default 0)")
     sp.add_argument("--out", metavar="DIR", default=None,
                     help="also write DIR/check_secondary.json, a chronophotograph of each "
                          "rollout and all of them in DIR/secondary_chrono.png")
@@ -1279,6 +1308,15 @@ def build_parser() -> argparse.ArgumentParser:
         one-legged hop). Each best point is re-simulated from the Table 3 state and 10 random
         states; "found" needs the classifier to name the target from the Table 3 state and
         from at least 80% of all states. Writes DIR/secondary.json and DIR/comparison.md.""")
+    sp.add_argument("--physics", action="store_true",
+                    help="choose each target's weight set by the body: network searches over "
+                         "a grid of target lags, every candidate driven through the one "
+                         "controller from --states random CPG states (seeds 1000 and up), the "
+                         "one both classifiers confirm most often kept")
+    sp.add_argument("--states", type=count_arg(1), default=6,
+                    help="with --physics: random CPG states per candidate (default 6, at most 32)")
+    sp.add_argument("--workers", type=count_arg(1), default=2,
+                    help="with --physics: parallel processes for the body (default 2)")
     sp.add_argument("--results", default=None,
                     help="folder with <gait>.json optimiser results (default out/optimize when "
                          "it exists; the paper's weights for any gait without one)")

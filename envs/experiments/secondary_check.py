@@ -50,12 +50,13 @@ def picture_stem(t: dict) -> str:
 
 
 def _one(args):
-    t, seconds, img_dir = args
+    t, seconds, img_dir, seed = args
     from cpgbiped.cpg.network import build
 
     from cpgbiped.envs.gaits.validate import validate
 
-    net = build("ml", t["source"], weights=t["weights"], i_app=t["i_app"], phi=t["phi"])
+    net = build("ml", t["source"], weights=t["weights"], i_app=t["i_app"], phi=t["phi"],
+                seed=seed)
     try:
         net.period()
     except InputError as e:
@@ -76,12 +77,21 @@ def _one(args):
     return row
 
 
-def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None) -> dict:
-    """{"<target> from <source>": {cpg_gait, physical_gait, fell, confirmed, metrics}};
-    with ``img_dir`` (an existing folder) each rollout's chronophotograph is written there
+CHECK_SEED = 3000  # first random CPG state of --states: the census's, never tuned or tested
+MAX_STATES = 100
+
+
+def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None,
+                    states: int = 0) -> dict:
+    """{"<target> from <source>": {cpg_gait, physical_gait, fell, confirmed, metrics}} from
+    the Table 3 state; with ``states`` > 0 also "random_states": {seeds, confirmed, falls,
+    physical_gaits} from that many random initial CPG states (seeds CHECK_SEED and up). With
+    ``img_dir`` (an existing folder) each Table 3 rollout's chronophotograph is written there
     and the panel of all of them, :func:`montage`."""
     targets = load_secondary(path)
-    jobs = [(t, seconds, None if img_dir is None else str(img_dir)) for t in targets]
+    seeds = list(range(CHECK_SEED, CHECK_SEED + int(states)))
+    jobs = [(t, seconds, None if img_dir is None else str(img_dir), None) for t in targets]
+    jobs += [(t, seconds, None, s) for t in targets for s in seeds]
     if workers > 1 and len(jobs) > 1:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
@@ -95,7 +105,15 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None)
     else:
         rows = [_one(j) for j in jobs]
     out = {}
-    for t, r in zip(targets, rows):  # a target found twice: the second named by its source
+    n = len(targets)
+    for k, (t, r) in enumerate(zip(targets, rows[:n])):
+        if seeds:
+            more = rows[n + k * len(seeds):n + (k + 1) * len(seeds)]
+            r["random_states"] = {"seeds": seeds,
+                                  "confirmed": int(sum(m["confirmed"] for m in more)),
+                                  "falls": int(sum(bool(m["fell"]) for m in more)),
+                                  "physical_gaits": [m["physical_gait"] for m in more]}
+        # a target found twice: the second named by its source
         out[t["target"] if t["target"] not in out else f"{t['target']} from {t['source']}"] = r
     if img_dir is not None:
         pics = [Path(img_dir) / f"{picture_stem(t)}_chrono.png" for t in targets]
@@ -146,6 +164,10 @@ def table(res: dict) -> str:
         rows.append([name, "yes" if r["found_in_network"] else "no", r["cpg_gait"],
                      r["physical_gait"], "-" if r["fell"] is None else ("yes" if r["fell"] else "no"),
                      f(r.get("lr_phase_lag")), f(r.get("flight")),
-                     "CONFIRMED" if r["confirmed"] else "-"])
+                     "CONFIRMED" if r["confirmed"] else "-"]
+                    + ([f"{r['random_states']['confirmed']}/{len(r['random_states']['seeds'])}"
+                        f", {r['random_states']['falls']} falls"] if "random_states" in r else []))
+    more = any("random_states" in r for r in res.values())
     return format_table(rows, ["target", "found in network", "cpg", "physical", "fell",
-                               "L-R lag", "flight", "in the body"])
+                               "L-R lag", "flight", "in the body"]
+                        + (["random states: confirmed"] if more else []))
