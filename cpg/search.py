@@ -176,6 +176,7 @@ def _optimize_primary(rd: ResultDir, gait, rs, lo, hi, settings, evaluator, prog
 
 # ------------------------------------------------------------------------------ secondary
 LAG_MATCH = 0.03  # cycles: a candidate's extensor lag this close to the target lag counts
+WEIGHT_DIGITS = 6  # decimals of the directed weights in secondary.json
 
 
 def secondary_search(target: str, source: str, keep: str, base_weights, rs: RunSettings,
@@ -196,8 +197,8 @@ def secondary_search(target: str, source: str, keep: str, base_weights, rs: RunS
     best = int(np.argmin(F.sum(axis=1)))
     out = secondary_point(problem, base_weights, problem.directed(res.pareto_X[best])[0],
                           F[best], rs, settings, n_confirm)
-    if candidates:
-        W = problem.directed(res.pareto_X)
+    if candidates:  # rounded as the results file stores them: the body sees what is kept
+        W = np.round(problem.directed(res.pareto_X), WEIGHT_DIGITS)
         ev = evaluate(target, problem.i_app, problem.phi, ml.directed_matrix(W),
                       np.repeat(problem.y0[None], len(W), axis=0), settings)
         lag = extensor_lag(ev.phases_deg)
@@ -231,7 +232,8 @@ def secondary_point(problem: SymmetryBreakingProblem, base_weights, w12, objecti
         "target": target, "source": problem.source, "kept_symmetry": problem.keep,
         "i_app": problem.i_app, "phi": problem.phi,
         "base_weights": list(map(float, base_weights)),
-        "directed_weights": dict(zip(ml.DIRECTED_NAMES, np.round(np.asarray(w12, float), 6).tolist())),
+        "directed_weights": dict(zip(ml.DIRECTED_NAMES,
+                                     np.round(np.asarray(w12, float), WEIGHT_DIGITS).tolist())),
         "objectives": np.round(np.asarray(objectives, float), 4).tolist(),
         "objective_names": names,
         "classified_from_table3_state": ev.classified[0],

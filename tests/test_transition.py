@@ -362,10 +362,15 @@ def test_check_secondary_counts_random_states(tmp_path):
     assert r.returncode == 2 and "--states must be at most 100" in r.stderr
 
 
-def test_secondary_physics_bounds_its_states(tmp_path):
-    r = _cli("secondary", "--physics", "--states", "33", "--out", str(tmp_path / "s"), timeout=60)
+@pytest.mark.parametrize("args,says", [
+    (["--physics", "--states", "33"], "--states must be at most 32"),
+    (["--states", "3"], "need --physics"),
+    (["--workers", "1"], "need --physics"),
+])
+def test_secondary_physics_options_are_checked_first(tmp_path, args, says):
+    r = _cli("secondary", *args, "--out", str(tmp_path / "s"), timeout=60)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
-    assert "--states must be at most 32" in r.stderr and not (tmp_path / "s").exists()
+    assert says in r.stderr and not (tmp_path / "s").exists()
 
 
 # The weight sets that `cpgbiped secondary --physics --out out/secondary_physics` (seed 0, the

@@ -519,11 +519,18 @@ def cmd_secondary(a) -> int:
     from cpgbiped.cpg.outdir import ResultDir
     from cpgbiped.cpg.search import comparison_markdown, load_result, secondary_all, write_secondary
 
-    check_workers(a)
     from cpgbiped.envs.search.secondary_physics import MAX_STATES
 
-    if a.physics and a.states > MAX_STATES:
-        raise _input_error(f"--states must be at most {MAX_STATES}, got {a.states}")
+    if not a.physics and (a.states is not None or a.workers is not None):
+        raise _input_error("--states and --workers choose how the body is driven: they need "
+                           "--physics")
+    if a.physics:
+        a.states = 6 if a.states is None else a.states
+        a.workers = min(2, os.cpu_count() or 1) if a.workers is None else a.workers
+    check_workers(a)  # --workers within the cores, a --dask address reachable
+    if a.physics:
+        if a.states > MAX_STATES:
+            raise _input_error(f"--states must be at most {MAX_STATES}, got {a.states}")
     if a.results is not None and not os.path.isdir(a.results):
         raise _input_error(f"--results {a.results!r} is not a folder of optimiser results")
     a.results = a.results or "out/optimize"
@@ -554,16 +561,14 @@ def cmd_secondary(a) -> int:
             if a.physics:
                 from cpgbiped.envs.search.secondary_physics import physics_secondary
 
-                searches = iter(range(1, 10_000))
-
                 def each_search(gen, n):  # one bar, reset for each network search
                     if gen == 1:
                         bar.reset(total=n)
-                        bar.set_description(f"network search {next(searches)}, then the body")
                     advance(gen, n)
 
                 results = physics_secondary(weights, rs, states=a.states, workers=a.workers,
-                                            evaluator=ev, progress=each_search)
+                                            evaluator=ev, progress=each_search,
+                                            note=bar.set_description)
             else:
                 results = secondary_all(weights, rs, evaluator=ev, progress=prog)
             bar.close()
@@ -1313,10 +1318,11 @@ def build_parser() -> argparse.ArgumentParser:
                          "a grid of target lags, every candidate driven through the one "
                          "controller from --states random CPG states (seeds 1000 and up), the "
                          "one both classifiers confirm most often kept")
-    sp.add_argument("--states", type=count_arg(1), default=6,
+    sp.add_argument("--states", type=count_arg(1), default=None,
                     help="with --physics: random CPG states per candidate (default 6, at most 32)")
-    sp.add_argument("--workers", type=count_arg(1), default=2,
-                    help="with --physics: parallel processes for the body (default 2)")
+    sp.add_argument("--workers", type=count_arg(1), default=None,
+                    help="with --physics: parallel processes for the body (default 2, or 1 on "
+                         "one core)")
     sp.add_argument("--results", default=None,
                     help="folder with <gait>.json optimiser results (default out/optimize when "
                          "it exists; the paper's weights for any gait without one)")

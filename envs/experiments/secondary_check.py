@@ -12,7 +12,8 @@ With an output folder (``cpgbiped check-secondary ... --out DIR``), each rollout
 drawn: a chronophotograph of its last two strides before the end of the window or the fall
 (``<target>_from_<source>_chrono.png``, :mod:`cpgbiped.envs.media.chrono`, with the footfall
 strip), and all of them in one picture, ``secondary_chrono.png``, one panel per weight set in
-the file's order, so that what the body does with each secondary rhythm can be seen.
+the file's order (a weight set whose network has no rhythm drives no body and has no
+picture), so that what the body does with each secondary rhythm can be seen.
 """
 from __future__ import annotations
 
@@ -45,8 +46,9 @@ def load_secondary(path) -> list[dict]:
 
 
 def picture_stem(t: dict) -> str:
-    """File stem of one weight set's pictures: ``<target>_from_<source>``."""
-    return f"{t['target']}_from_{t['source']}"
+    """File stem of one weight set's pictures: ``<target>_from_<source>``, with the weight
+    set's place in the file (``_2``, ...) for a pair the file holds more than once."""
+    return f"{t['target']}_from_{t['source']}" + (f"_{t['repeat']}" if t.get("repeat") else "")
 
 
 def _one(args):
@@ -89,6 +91,11 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None,
     ``img_dir`` (an existing folder) each Table 3 rollout's chronophotograph is written there
     and the panel of all of them, :func:`montage`."""
     targets = load_secondary(path)
+    seen: dict = {}
+    for t in targets:  # pictures of a repeated (target, source) pair do not overwrite
+        key = (t["target"], t["source"])
+        seen[key] = seen.get(key, 0) + 1
+        t["repeat"] = seen[key] if seen[key] > 1 else 0
     seeds = list(range(CHECK_SEED, CHECK_SEED + int(states)))
     jobs = [(t, seconds, None if img_dir is None else str(img_dir), None) for t in targets]
     jobs += [(t, seconds, None, s) for t in targets for s in seeds]
@@ -111,13 +118,17 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None,
             more = rows[n + k * len(seeds):n + (k + 1) * len(seeds)]
             r["random_states"] = {"seeds": seeds,
                                   "confirmed": int(sum(m["confirmed"] for m in more)),
-                                  "falls": int(sum(bool(m["fell"]) for m in more)),
-                                  "physical_gaits": [m["physical_gait"] for m in more]}
+                                  "falls": int(sum(m["fell"] is True for m in more)),
+                                  "physical_gaits": [m["physical_gait"] for m in more],
+                                  "touchdown_lags": [m.get("lr_phase_lag") for m in more],
+                                  "flights": [m.get("flight") for m in more]}
         # a target found twice: the second named by its source
         out[t["target"] if t["target"] not in out else f"{t['target']} from {t['source']}"] = r
     if img_dir is not None:
         pics = [Path(img_dir) / f"{picture_stem(t)}_chrono.png" for t in targets]
-        montage([p for p in pics if p.exists()], Path(img_dir) / "secondary_chrono.png")
+        pics = [p for p in pics if p.exists()]  # a network without a rhythm drove no body
+        if pics:
+            montage(pics, Path(img_dir) / "secondary_chrono.png")
     return out
 
 

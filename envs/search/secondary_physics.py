@@ -11,11 +11,16 @@ the primary gaits:
    the touchdowns; the paper's patterns fix which cells share a waveform, not the lag between
    the two waveforms. For these three the network search runs once per target lag of a grid
    over the lags the rule admits (:func:`lag_grid`, ``LAG_STEP`` apart), with a fourth
-   objective that pulls the extensors' lag to it (the legs' stances follow the extensors'
-   bursts); for the skip and the one-legged hop, whose rules are not lags, once, as without
-   ``--physics``.
+   objective that pulls the extensors' lag to it. The grid is a sweep of the network's
+   extensor lag over the band the contact rule admits for the touchdowns: the body's
+   touchdown lag does not follow the extensors' one to one (a hesitation walk chosen at an
+   extensor lag of 0.18 steps at 0.41 from 0), which is why the body, not the grid, chooses.
+   For the skip and the one-legged hop, whose rules are not lags, the search runs once, as
+   without ``--physics``.
 2. **Candidates.** Every Pareto point of those searches that the CPG classifier names the
-   target from the Table 3 state, with its extensor lag within ``LAG_MATCH`` of the target lag.
+   target from the Table 3 state (the network search's own criterion: it searches from that
+   state, as the paper does), with its extensor lag within ``LAG_MATCH`` of the target lag,
+   its weights rounded as the results file stores them.
 3. **Selection by the body.** Each candidate drives the body from ``states`` random initial
    CPG states, seeds ``SELECTION_SEED`` and up (CPG states the controller's tuning uses too:
    never the Table 3 state, from which ``check-secondary`` then judges the chosen set, nor the
@@ -74,11 +79,13 @@ def _rollout(args) -> dict:
     net = build("ml", source, weights=list(w12), i_app=i_app, phi=phi, seed=seed)
     try:
         net.period()
-    except InputError:
-        return {"cpg_gait": "none", "physical_gait": "none", "fell": True, "confirmed": False}
+    except InputError:  # no rhythm from this state: no rollout, not a fall
+        return {"cpg_gait": "none", "physical_gait": "none", "fell": None, "confirmed": False,
+                "lr_phase_lag": None}
     s = validate(net, None, seconds).summary()
     return {"cpg_gait": s["cpg_gait"], "physical_gait": s["physical_gait"], "fell": s["fell"],
-            "confirmed": bool(s["cpg_gait"] == target == s["physical_gait"] and not s["fell"])}
+            "confirmed": bool(s["cpg_gait"] == target == s["physical_gait"] and not s["fell"]),
+            "lr_phase_lag": s["lr_phase_lag"]}
 
 
 def _map(fn, jobs, workers: int) -> list:
@@ -93,19 +100,20 @@ def _map(fn, jobs, workers: int) -> list:
 
 
 def score(rows: list[dict], objectives) -> tuple:
-    """Sort key of one candidate (smaller is better): most confirmations, fewest falls,
-    smallest sum of the network objectives."""
-    return (-sum(r["confirmed"] for r in rows), sum(bool(r["fell"]) for r in rows),
+    """Sort key of one candidate (smaller is better): most confirmations, fewest falls (a
+    state without a rhythm, ``fell`` None, is no fall), smallest sum of the network
+    objectives."""
+    return (-sum(r["confirmed"] for r in rows), sum(r["fell"] is True for r in rows),
             float(np.sum(objectives)))
 
 
 def physics_secondary(primary_weights: dict, rs: RunSettings, settings: SimSettings = SimSettings(),
                       states: int = 6, seconds: float = SELECTION_SECONDS, workers: int = 2,
                       evaluator=None, progress=None, targets=SECONDARY_TARGETS,
-                      on_target=None) -> list[dict]:
+                      on_target=None, note=None) -> list[dict]:
     """The secondary results (as :func:`cpgbiped.cpg.search.secondary_all`), each target's
     weight set chosen by the body; see the module docstring. ``on_target(entry)`` is called
-    as each target is done."""
+    as each target is done, ``note(text)`` says what runs now (a progress bar's label)."""
     from cpgbiped.cpg.search import secondary_point, secondary_search
 
     if not 1 <= int(states) <= MAX_STATES:
@@ -113,17 +121,26 @@ def physics_secondary(primary_weights: dict, rs: RunSettings, settings: SimSetti
 
         raise InputError(f"--states must be in [1, {MAX_STATES}], got {states}")
     seeds = selection_seeds(states)
+    n_searches = sum(len(lag_grid(t) or [None]) for t, _, _, _ in targets)
+    done = 0
     out = []
     for target, source, keep, paper in targets:
         base = primary_weights[source]
         cands = []
         for lag in lag_grid(target) or [None]:
-            r = secondary_search(target, source, keep, base, rs, settings, evaluator=evaluator,
-                                 progress=progress, target_lag=lag, candidates=True)
-            cands += [dict(c, target_lag=lag) for c in r.pop("candidates")]
+            done += 1
+            if note is not None:
+                note(f"{target} from the {source}: network search {done} of {n_searches}")
+            plain = secondary_search(target, source, keep, base, rs, settings,
+                                     evaluator=evaluator, progress=progress, target_lag=lag,
+                                     candidates=True)
+            cands += [dict(c, target_lag=lag) for c in plain.pop("candidates")]
         p = ml.preset(source)
         jobs = [(target, source, c["directed_weights"], p.i_app, p.phi, s, seconds)
                 for c in cands for s in seeds]
+        if note is not None and jobs:
+            note(f"{target} from the {source}: the body, {len(cands)} candidates x "
+                 f"{len(seeds)} states")
         rows = _map(_rollout, jobs, workers)
         per = [rows[k * len(seeds):(k + 1) * len(seeds)] for k in range(len(cands))]
         if cands:
@@ -137,11 +154,12 @@ def physics_secondary(primary_weights: dict, rs: RunSettings, settings: SimSetti
                 "states": seeds, "seconds": seconds, "candidates": len(cands),
                 "target_lag": c["target_lag"], "extensor_lag": round(c["extensor_lag"], 4),
                 "confirmed_states": int(sum(r["confirmed"] for r in per[k])),
-                "falls": int(sum(bool(r["fell"]) for r in per[k])),
+                "falls": int(sum(r["fell"] is True for r in per[k])),
                 "physical_gaits": [r["physical_gait"] for r in per[k]],
+                "touchdown_lags": [r["lr_phase_lag"] for r in per[k]],
                 "confirmed_per_candidate": [int(sum(r["confirmed"] for r in q)) for q in per]}
         elif lag_grid(target) is None:
-            entry = r  # the plain search's point
+            entry = plain  # the plain search's point
             entry["physics"] = {"states": seeds, "seconds": seconds, "candidates": 0}
         else:  # no candidate at any target lag: the plain search's point
             entry = secondary_search(target, source, keep, base, rs, settings,
