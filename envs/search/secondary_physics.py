@@ -162,6 +162,8 @@ def physics_secondary(primary_weights: dict, rs: RunSettings, settings: SimSetti
             entry = plain  # the plain search's point
             entry["physics"] = {"states": seeds, "seconds": seconds, "candidates": 0}
         else:  # no candidate at any target lag: the plain search's point
+            if note is not None:
+                note(f"{target} from the {source}: no candidate, the plain network search")
             entry = secondary_search(target, source, keep, base, rs, settings,
                                      evaluator=evaluator, progress=progress)
             entry["physics"] = {"states": seeds, "seconds": seconds, "candidates": 0}
