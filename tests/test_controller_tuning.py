@@ -63,6 +63,28 @@ def test_cost_follows_the_criteria():
     assert rollout_cost("walk", bent, 10.0) == pytest.approx(c_good + 2.0)
 
 
+def test_shortfall_weight_scales_only_the_criteria_term():
+    """--shortfall-weight W multiplies the criteria's shortfall and nothing else: a walk that
+    misses its duty (0.5 against 0.55) costs W x its shortfall more than at weight 0, and a
+    walk that meets every criterion with the margin costs the same at any weight; a weight
+    outside [0, 100] or not finite is refused."""
+    from cpgbiped.envs.search.controller_tuning import MARGIN, SHORTFALL
+
+    short = walk_summary(duty=0.5)
+    gap = CRITERIA["walk"].shortfall(short, MARGIN)
+    assert gap > 0.0
+    base = rollout_cost("walk", short, 10.0, shortfall=0.0)
+    for w in (SHORTFALL, 12.0):
+        assert rollout_cost("walk", short, 10.0, shortfall=w) == pytest.approx(base + w * gap)
+    good = walk_summary()
+    assert CRITERIA["walk"].shortfall(good, MARGIN) == 0.0
+    assert rollout_cost("walk", good, 10.0, shortfall=12.0) == rollout_cost("walk", good, 10.0)
+    assert TuneSettings(("run",)).shortfall_weight == SHORTFALL
+    for bad in (-1.0, float("nan"), 101.0):
+        with pytest.raises(InputError, match="shortfall-weight"):
+            TuneSettings(("run",), shortfall_weight=bad)
+
+
 def test_target_speed_is_above_the_criteria():
     for g in ("walk", "run"):
         v = target_speed(g)

@@ -414,7 +414,8 @@ def cmd_tune(a) -> int:
     n_cond, ids = a.conditions
     guard = check_gaits(a.guard) if a.guard else ()
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
-                            n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "")
+                            n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "",
+                            a.shortfall_weight)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1295,6 +1296,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "cannot buy it with another gait's quality")
     sp.add_argument("--guard-gains", default=None, metavar="GAINS.json",
                     help="the gains the guard compares with (default: --start)")
+    sp.add_argument("--shortfall-weight", type=finite_arg, default=3.0, metavar="W",
+                    help="weight of the criteria's pattern and quality shortfalls in the cost "
+                         "(default 3, against 10 for seconds upright and for progress; 0-100)")
     sp.add_argument("--workers", type=count_arg(1), default=None,
                     help="rollout processes (default: one per core)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",

@@ -29,7 +29,9 @@ Cost of one rollout (lower is better), from the criteria of :mod:`cpgbiped.envs.
                                                   forwards (until a fall), v* the speed of
                                                   TARGET_FROUDE (above the criteria's minimum)
   + FALL                                          if it fell (and nothing more), else
-  + SHORTFALL x Criteria.shortfall (margin MARGIN)  pattern and quality terms
+  + w_s x Criteria.shortfall (margin MARGIN)      pattern and quality terms; w_s =
+                                                  SHORTFALL unless ``--shortfall-weight``
+                                                  sets it (TuneSettings.shortfall_weight)
   + 2 |stride - CPG period| / CPG period           one stride per CPG cycle: the rhythm is the
                                                   network's, not a bounce of the body
   + 2 sum over feet max(0, |footfalls per stride - 1| - 0.05)
@@ -110,6 +112,7 @@ if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHAR
 
 TARGET_FROUDE = {"walk": 0.11, "run": 0.33}  # progress target (criteria: Fr >= 0.08, 0.25)
 SURVIVAL, PROGRESS, FALL, SHORTFALL, MARGIN = 10.0, 10.0, 5.0, 3.0, 0.03
+MAX_SHORTFALL_WEIGHT = 100.0  # --shortfall-weight's bound (a sanity bound, not a tuned value)
 POSTURE, LEAN_FREE_DEG = 1.0, 10.0  # per 10 deg of mean trunk lean beyond 10 deg
 # The guard (--guard): a guarded gait's cost in a condition may exceed its cost under the
 # guard's gains by GUARD_TOL (the rollouts are deterministic, but a body this chaotic moves
@@ -246,6 +249,7 @@ class TuneSettings:
     condition_ids: tuple[int, ...] = ()  # 1-based tuning conditions (empty: the first n_conditions)
     guard: tuple[str, ...] = ()  # gaits that may not get worse than under guard_gains
     guard_gains: str = ""  # the gains file the guard compares with (empty: the start's)
+    shortfall_weight: float = SHORTFALL  # weight of the pattern and quality shortfalls
 
     def conditions(self) -> list[dict]:
         """The tuning conditions every candidate is scored under."""
@@ -289,6 +293,10 @@ class TuneSettings:
                     f"{cond['push'][0] - SETTLE_S:g} or leave condition {k} out")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
+        if not (np.isfinite(self.shortfall_weight)
+                and 0.0 <= self.shortfall_weight <= MAX_SHORTFALL_WEIGHT):
+            raise InputError(f"--shortfall-weight must be in [0, {MAX_SHORTFALL_WEIGHT:g}], "
+                             f"got {self.shortfall_weight}")
         if self.only and not variables(self):
             raise InputError(f"--only {','.join(self.only)} names no gain that --search "
                              f"{self.search} searches")
@@ -342,9 +350,10 @@ def target_speed(gait: str) -> float | None:
     return None if fr is None else float(np.sqrt(fr * 9.81 * body_constants()[0]))
 
 
-def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S) -> float:
+def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S,
+                 shortfall: float = SHORTFALL) -> float:
     """The cost of one rollout summary (:func:`cpgbiped.envs.simulation.trials.run_control_trial`); see the module
-    docstring."""
+    docstring. ``shortfall``: the weight of the pattern and quality shortfalls."""
     up = float(np.clip(s["survived_s"] - settle_s, 0.0, seconds))
     c = SURVIVAL * (1.0 - up / seconds)
     v = target_speed(gait)
@@ -353,7 +362,7 @@ def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S)
         c += PROGRESS * (1.0 - min(d, v * seconds) / (v * seconds))
     if s["fell"]:
         return c + FALL
-    c += SHORTFALL * CRITERIA[gait].shortfall(s, MARGIN)
+    c += shortfall * CRITERIA[gait].shortfall(s, MARGIN)
     lean = s.get("trunk_lean_deg")
     if lean is not None and np.isfinite(lean):  # an upright trunk, as animals' gaits have
         c += POSTURE * max(0.0, abs(lean) - LEAN_FREE_DEG) / 10.0
@@ -393,7 +402,8 @@ class ControllerTuningProblem(Problem):
     def gait_costs(self, results: list) -> np.ndarray:
         """(n_conditions, n_gaits) rollout costs of one point's results (condition-major)."""
         n_g, n_c = len(self.settings.gaits), len(self.conditions)
-        return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds)
+        return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds,
+                                       shortfall=self.settings.shortfall_weight)
                           for j, g in enumerate(self.settings.gaits)] for c in range(n_c)])
 
     def reference_costs(self) -> np.ndarray:
@@ -599,7 +609,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                          cond.get("friction_scale", 1.0),
                          cond.get("push", ""), cond.get("weights", {}).get(g, ""),
                          cond.get("feedback", 0.0),
-                         round(rollout_cost(g, s, settings.seconds), 4),
+                         round(rollout_cost(g, s, settings.seconds,
+                                            shortfall=settings.shortfall_weight), 4),
                          s["fell"], s["physical_gait"], _r(s["speed_mps"]), _r(s["froude"]),
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
