@@ -3,6 +3,8 @@ link of the tuning chain (set_by_hand, with what was set and why), from START's 
 OUT/rk/gains.json.
 
     python scripts/run_soft_knee.py START.json OUT
+    python scripts/run_soft_knee.py --free     (the run corner's gains the stages after it
+                                                search: all but HELD and the opt-in ones)
 
 Why (README, "Run"): the run bounded (duty 0.13, flight 0.74) because its stance leg launched
 at once: the ankle's balance reflex (k_av 1.6 activation per m/s) held both extensors saturated
@@ -16,14 +18,25 @@ stages after it search the run corner's other gains with these held.
 import sys
 from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.control.control_kernel import BLENDED
+from cpgbiped.envs.search.controller_tuning import OPT_IN, set_by_hand
 
 HELD = {"alternating_coactive.k_ax": 0.0, "alternating_coactive.k_av": 0.0,
         "alternating_coactive.knee_ext": -0.75, "alternating_coactive.kp_push": 0.5,
         "alternating_coactive.push": 0.25}
 
 
+def free_gains() -> list[str]:
+    """The run corner's gains that the stages after this link search: every blended gain but
+    the ones held here and the opt-in ones (searched only when named)."""
+    held = {n.split(".")[-1] for n in HELD} | set(OPT_IN)
+    return [f"alternating_coactive.{g}" for g in BLENDED if g not in held]
+
+
 def main() -> None:
+    if sys.argv[1:] == ["--free"]:
+        print(",".join(free_gains()))
+        return
     start, out = sys.argv[1], Path(sys.argv[2])
     set_by_hand(start, HELD, out / "rk" / "gains.json",
                 "the run corner's stance leg launched the body (saturated ankle reflex, a "

@@ -86,10 +86,7 @@ PY
 # over 4 conditions of 16 s, then 8 of 20 s. About 6 minutes.
 python3 scripts/run_soft_knee.py "$prev" "$OUT"
 prev="$OUT/rk/gains.json"
-RUN_FREE=$(python3 -c "
-from cpgbiped.envs.control.control_kernel import BLENDED
-held = {'k_ax', 'k_av', 'knee_ext', 'kp_push', 'push', 'land_yield'}
-print(','.join('alternating_coactive.' + g for g in BLENDED if g not in held))")
+RUN_FREE=$(python3 scripts/run_soft_knee.py --free)
 stage rs1 --gait run --only "$RUN_FREE" --conditions 4 --seconds 16 --gens 60 --pop 16 --sigma 0.15 --seed 107 --shortfall-weight 12
 stage rs2 --gait run --only "$RUN_FREE" --conditions 8 --seconds 20 --gens 60 --pop 16 --sigma 0.08 --seed 108 --shortfall-weight 12
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"

@@ -405,8 +405,8 @@ def only_arg(text: str) -> tuple[str, ...]:
 def cmd_tune(a) -> int:
     from cpgbiped.cpg.optimize import RunSettings
     from cpgbiped.envs.control.controller import GAINS_FILE
-    from cpgbiped.envs.search.controller_tuning import (HORIZON, TuneSettings, check_gaits, tune,
-                                                          variables)
+    from cpgbiped.envs.search.controller_tuning import (HORIZON, SHORTFALL, TuneSettings,
+                                                          check_gaits, tune, variables)
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
@@ -415,7 +415,7 @@ def cmd_tune(a) -> int:
     guard = check_gaits(a.guard) if a.guard else ()
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
                             n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "",
-                            a.shortfall_weight)
+                            SHORTFALL if a.shortfall_weight is None else a.shortfall_weight)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1296,7 +1296,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "cannot buy it with another gait's quality")
     sp.add_argument("--guard-gains", default=None, metavar="GAINS.json",
                     help="the gains the guard compares with (default: --start)")
-    sp.add_argument("--shortfall-weight", type=finite_arg, default=3.0, metavar="W",
+    sp.add_argument("--shortfall-weight", type=finite_arg, default=None, metavar="W",
                     help="weight of the criteria's pattern and quality shortfalls in the cost "
                          "(default 3, against 10 for seconds upright and for progress; 0-100)")
     sp.add_argument("--workers", type=count_arg(1), default=None,
