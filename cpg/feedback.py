@@ -16,7 +16,7 @@ Sensors, per leg l (0 left, 1 right), measured at every control tick:
 Cells in the order LF, RF, LE, RE (flexor and extensor of the left and right ankle); for leg
 l its flexor is cell l and its extensor cell 2 + l. One gain K >= 0 scales every pathway.
 
-Morris-Lecar: three pathways were built and measured (input currents in model units); the
+Morris-Lecar: four pathways were built and measured (input currents in model units); the
 chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuoka network:
   "angle" (chosen): contact-gated thigh angle, a current into each cell of leg l:
     dv_l/dt += K (-q_l / THETA_REF),    dv_{2+l}/dt += -K (-q_l / THETA_REF)
@@ -28,13 +28,14 @@ chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuok
   "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2);
   "reset": a touchdown pulse (phase resetting, Aoi & Tsuchiya): dv_{2+l}/dt += K p_l,
     dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0.
-  scripts/feedback_choice.py scored every form at K = 0.01, 0.03, 0.1 by the push envelope
-  of the walk and the run on tuning conditions (CPG seed 1000, pushes after 5.5 s), keeping
-  only gains at which the CPG classifier still names the gait: "angle" at K = 0.01 scored
-  47.5 N s (open loop 40), "load" at best 42.5 (K = 0.03), "load_antagonist" 40 (K = 0.01),
-  "reset" 40 at K = 0.05 (as open loop); at K = 0.1 the load forms and the reset turn the
-  network's walk (and the load forms its run) into a skip (cpg/feedback_gains.json holds every
-  candidate's numbers).
+  scripts/feedback_choice.py scores every form at K = 0.01-0.1 by the push envelope of the
+  walk and the run on tuning conditions (CPG seeds 1000-1003, pushes after 5.5 s), keeping only
+  gains at which no rollout falls, the CPG classifier still names the gait, and each preset
+  passes its gait's criteria in as many seeds as open loop: "angle" at K = 0.01 scored 115 N s
+  (open loop 97.5); "load_antagonist" at K = 0.03 scored 145 but passed the criteria in 2 of
+  8 rollouts (open loop 7), and on the test conditions its walk passed in 1 of 13 and its run
+  in none; at K = 0.1 the load forms and the reset turn the network's walk into a skip or
+  none (cpg/feedback_gains.json holds every candidate's numbers).
 Hopf (Tegotae, Owaki & Ishiguro 2013/2017: each extensor oscillator's phase is pushed by its
 leg's load). With the phase theta_i = atan2(y_i, x_i) (the oscillator's stance half, y > 0,
 is theta in (0, pi); the body's burst, y above the preset's activation centre, lies inside it):

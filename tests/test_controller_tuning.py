@@ -353,6 +353,25 @@ def test_tuning_walk_networks_are_walks_the_tests_never_use():
             assert condition_trial("run", (), c).weights is None
 
 
+def test_the_closed_loop_tuning_conditions_keep_the_loop_the_chain_was_tuned_in(monkeypatch):
+    """The closed-loop tuning conditions close the loop through Taga's thigh angle at K = 0.01
+    (the recommended feedback when the committed chain was tuned), whatever the recommended
+    choice (cpg/feedback_gains.json) is now: replaying a recorded run of the chain must roll out
+    the loop it was tuned in. Checked with the recommendation replaced by another pathway."""
+    import cpgbiped.cpg.feedback as fb
+    from cpgbiped.envs.control.controller import params_array
+    from cpgbiped.envs.search.controller_tuning import TUNING_FEEDBACK, condition_trial
+
+    monkeypatch.setitem(fb.CHOICE, "ml", ("load", 0.1))
+    monkeypatch.setitem(fb.RECOMMENDED, "ml", 0.1)
+    closed = [c for c in tuning_conditions(16) if c.get("feedback")]
+    assert TUNING_FEEDBACK == ("angle", 0.01) and len(closed) == 4
+    for c in closed:
+        t = condition_trial("walk", tuple(params_array(CONTROL)), c)
+        assert (t.feedback_form, t.feedback) == ("angle", 0.01)
+    assert condition_trial("walk", (), tuning_conditions(1)[0]).feedback == 0.0
+
+
 def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     """Conditions 17-20 roll every gait's Hopf preset out: the trial's CPG period is the Hopf
     network's (the Morris-Lecar walk's differs: 13.1 model units at 12.3 per second, 1.07 s)."""

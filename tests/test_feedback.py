@@ -266,8 +266,10 @@ def test_the_recommended_gains_are_the_rule_applied_to_the_recorded_candidates()
     """cpg/feedback_gains.json keeps every candidate's rollouts (scripts/feedback_choice.py).
     Re-applied here, independently of the script: per network, a candidate is admissible when
     no rollout falls and the CPG still names the gait it names open loop, for every preset and
-    every one of the four tuning CPG seeds; the recommendation is the best summed score among
-    the admissible ones with K > 0 (the first listed among equals)."""
+    every one of the four tuning CPG seeds, and when, for each preset, its unperturbed rollout
+    passes the preset's criteria in at least as many seeds as open loop; the recommendation is
+    the best summed score among the admissible ones with K > 0 (the first listed among
+    equals)."""
     from cpgbiped.cpg.feedback import GAINS_FILE
 
     d = json.loads(GAINS_FILE.read_text())
@@ -276,7 +278,11 @@ def test_the_recommended_gains_are_the_rule_applied_to_the_recorded_candidates()
     for kind, chosen in d["networks"].items():
         mine = [r for r in rows if r["network"] == kind]
         named_open = {(r["preset"], r["cpg_seed"]): r["cpg_gait"] for r in mine if r["gain"] == 0}
-        order, score, ok = [], {}, {}
+        passed_open = {}
+        for r in mine:
+            if r["gain"] == 0:
+                passed_open[r["preset"]] = passed_open.get(r["preset"], 0) + r["criteria_passed"]
+        order, score, ok, passed = [], {}, {}, {}
         for r in mine:
             if r["gain"] == 0:
                 continue
@@ -286,6 +292,9 @@ def test_the_recommended_gains_are_the_rule_applied_to_the_recorded_candidates()
                 score[key], ok[key] = 0.0, True
             score[key] += min(r["forward_ns"]) + min(r["backward_ns"])
             ok[key] &= (not r["fell"]) and r["cpg_gait"] == named_open[(r["preset"], r["cpg_seed"])]
+            passed[key + (r["preset"],)] = passed.get(key + (r["preset"],), 0) + r["criteria_passed"]
+        for key in order:
+            ok[key] &= all(passed[key + (p,)] >= n for p, n in passed_open.items())
         best = max((k for k in order if ok[k]), key=lambda k: score[k])
         assert best == (chosen["form"], chosen["recommended_gain"]), (kind, best, chosen)
         assert CHOICE[kind] == best

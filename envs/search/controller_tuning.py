@@ -15,8 +15,7 @@ drive down to 0.1, and the run, which swings on it, could no longer lift a leg.
 Conditions. Every candidate drives each named preset under every tuning condition
 (:func:`tuning_conditions`): a random initial CPG state drawn from a seed of 1000 or more,
 some with another floor friction or a horizontal push on the torso; from the ninth on, the
-walk driven by another walk network or the loop closed at the recommended feedback gain
-(:data:`TUNING_WALKS`); from the seventeenth on, every preset driven by the Hopf network's.
+walk driven by another walk network or the loop closed (:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's.
 The tests and the README report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
@@ -160,12 +159,19 @@ def extensor_overlap(gait: str, seed: int, t0_s: float = 0.5, t1_s: float = 3.0)
                                                       * (e[:, 1] ** 2).mean()))
 
 
+# The Morris-Lecar feedback pathway and gain of the closed-loop tuning conditions (9-16): the
+# recommended choice of cpg/feedback_gains.json when the committed chain of tuning runs was
+# made (Taga's gated thigh angle, K = 0.01). Frozen here so that every recorded run of the chain
+# replays with the loop it was tuned in, whatever the recommended choice later becomes.
+TUNING_FEEDBACK = ("angle", 0.01)
+
+
 def tuning_conditions(n: int) -> list[dict]:
     """The first ``n`` tuning conditions: ``cpg_seed`` (a random initial CPG state), and for
     most of them a floor friction scale or a push (time s, impulse N s) on the torso. From the
     ninth on, half of them drive the walk by another walk network (``weights``:
     {"walk": (w_a, w_b, w_c)}, :data:`TUNING_WALKS`) and half close the loop (``feedback``:
-    the Morris-Lecar network's recommended gain, :mod:`cpgbiped.cpg.feedback`), so that the
+    the gain of :data:`TUNING_FEEDBACK`, through its pathway), so that the
     gains are paid for serving a walk rhythm rather than one network, and the coupled system.
     From the seventeenth on, every gait is driven by the Hopf network's preset (``network``:
     "hopf"), whose bursts have another shape (a walk's extensors burst for about 43% of the
@@ -173,14 +179,12 @@ def tuning_conditions(n: int) -> list[dict]:
     network's waveform. The twenty-first to twenty-fourth start from :data:`TRANSIENT_SEEDS`
     (the walk network starts in a jump's rhythm); pick them with
     :attr:`TuneSettings.condition_ids` (``--conditions 1-8,21-24``)."""
-    from cpgbiped.cpg.feedback import RECOMMENDED
-
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
     extra = [{}, {"friction_scale": 0.8}, {"friction_scale": 1.25}, {"push": (5.5, 4.0)},
              {"push": (5.5, -4.0)}, {"friction_scale": 0.6}, {"friction_scale": 1.6},
              {"push": (4.5, 3.0)}]
-    k_fb = float(RECOMMENDED["ml"])
+    k_fb = TUNING_FEEDBACK[1]
     variants = [{"weights": {"walk": TUNING_WALKS[0]}}, {"feedback": k_fb},
                 {"weights": {"walk": TUNING_WALKS[1]}}, {"feedback": k_fb, "friction_scale": 0.8},
                 {"weights": {"walk": TUNING_WALKS[0]}, "friction_scale": 1.25},
@@ -223,7 +227,8 @@ def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
     return ControlTrial(gait, control, cpg_seed=cond["cpg_seed"],
                         friction_scale=cond.get("friction_scale", 1.0), push=cond.get("push"),
                         weights=None if w is None else tuple(w),
-                        feedback=cond.get("feedback", 0.0), network=cond.get("network", "ml"))
+                        feedback=cond.get("feedback", 0.0), network=cond.get("network", "ml"),
+                        feedback_form=TUNING_FEEDBACK[0] if cond.get("feedback") else None)
 
 
 def check_gaits(text: str) -> tuple[str, ...]:

@@ -102,7 +102,8 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         net = build("ml", trial.preset, weights=list(trial.weights), i_app=trial.i_app,
                     phi=trial.phi, seed=trial.cpg_seed)
         rec = rollout(net, total, friction_scale=trial.friction_scale, push=trial.push,
-                      stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback)
+                      stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback,
+                  feedback_form=trial.feedback_form)
     except InputError as e:  # a network that diverges cannot drive the body
         return _failed(str(e))
     v = measure_recording(net, None, rec, settle_s)
@@ -126,8 +127,10 @@ class ControlTrial:
     (:func:`cpgbiped.envs.control.controller.params_array`) is ``control``, under a condition (friction
     scale, a push (time s, impulse N s)); ``weights`` (w_a, w_b, w_c) replace the preset's
     coupling weights (another network of the preset's family), ``feedback`` is the gain K of
-    the body's feedback into the CPG (0: open loop); ``network`` the kind of network whose
-    preset drives the body (``cpg.network.KINDS``; weights are Morris-Lecar's only)."""
+    the body's feedback into the CPG (0: open loop) and ``feedback_form`` its Morris-Lecar
+    pathway (None: the recommended one, ``cpg.feedback.CHOICE``); ``network`` the kind of
+    network whose preset drives the body (``cpg.network.KINDS``; weights are Morris-Lecar's
+    only)."""
 
     preset: str
     control: tuple
@@ -137,6 +140,7 @@ class ControlTrial:
     weights: tuple[float, float, float] | None = None
     feedback: float = 0.0
     network: str = "ml"
+    feedback_form: str | None = None
 
 
 def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SETTLE_S,
@@ -155,7 +159,8 @@ def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SET
                 weights=None if trial.weights is None else list(trial.weights))
     rec = rollout(net, total, params_from_array(np.asarray(trial.control, float)),
                   friction_scale=trial.friction_scale, push=trial.push,
-                  stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback)
+                  stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback,
+                  feedback_form=trial.feedback_form)
     s = measure_recording(net, trial.preset, rec, settle_s).summary()
     fell = bool(s["fell"]) or rec.unstable is not None
     s["fell"] = fell
