@@ -102,8 +102,7 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         net = build("ml", trial.preset, weights=list(trial.weights), i_app=trial.i_app,
                     phi=trial.phi, seed=trial.cpg_seed)
         rec = rollout(net, total, friction_scale=trial.friction_scale, push=trial.push,
-                      stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback,
-                  feedback_form=trial.feedback_form)
+                      stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback)
     except InputError as e:  # a network that diverges cannot drive the body
         return _failed(str(e))
     v = measure_recording(net, None, rec, settle_s)
