@@ -25,9 +25,11 @@ SMALL = PhysicsSettings(froude=0.5, seconds=4.0, n_trials=1)
 RS = RunSettings(pop=4, gens=3, seed=7, checkpoint_every=1)
 
 
-def result(fell=False, gait="walk", froude=0.1, cot=1.0, work=20.0, survived=12.0, v=None):
+def result(fell=False, gait="walk", froude=0.1, cot=1.0, work=20.0, survived=12.0, v=None,
+           cpg=None):
     v = math.sqrt(froude * G * body_constants()[0]) if v is None else v
-    return TrialResult(fell, survived, gait, froude, v, cot, work, 0.6, 0.0, 1.0, 0.0)
+    return TrialResult(fell, survived, gait, froude, v, cot, work, 0.6, 0.0, 1.0, 0.0,
+                       cpg_gait=gait if cpg is None else cpg)
 
 
 def test_score_objectives_and_graded_constraint():
@@ -36,8 +38,13 @@ def test_score_objectives_and_graded_constraint():
     F, g = score("walk", s, [ok, ok, result(fell=True), result(gait="run"), ok])
     assert F == pytest.approx([0.15, 0.8, 0.5]) and g == 0.0
     # A walk that falls halfway through its 12 s and is named another gait.
-    F, g = score("walk", s, [result(fell=True, gait="none", survived=6.0)] + [ok] * 4)
+    F, g = score("walk", s, [result(fell=True, gait="none", survived=6.0, cpg="walk")] + [ok] * 4)
     assert g == pytest.approx(1.0 + 0.5 + 1.0) and F[2] == 0.0
+    # The network must make the gait: contacts of a hop from cells the CPG classifier names
+    # none (or a jump) is one unit of violation, as another physical gait is.
+    assert score("hop", s, [result(gait="hop")])[1] == 0.0
+    assert score("hop", s, [result(gait="hop", cpg="none")])[1] == pytest.approx(1.0)
+    assert score("hop", s, [result(gait="jump", cpg="jump")])[1] == pytest.approx(2.0)
     # Jump and hop: work per stride in units of m g L, computed here from the model's numbers.
     leg, mass = body_constants()[:2]
     F, _ = score("hop", s, [result(gait="hop", work=30.0)])

@@ -67,6 +67,7 @@ class TrialResult:
     stride_period_s: float
     apex_height_m: float
     error: str | None = None
+    cpg_gait: str | None = None  # the gait the CPG classifier names from the cells (None: not measured)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -115,7 +116,7 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         cost_of_transport=_num(b.cost_of_transport), work_per_stride_J=_num(b.work_per_stride_J),
         duty=mean_finite([m.duty_factor["left"], m.duty_factor["right"]]),
         flight=_num(m.flight), stride_period_s=_num(m.stride_period_s),
-        apex_height_m=_num(b.apex_height_m), error=rec.unstable)
+        apex_height_m=_num(b.apex_height_m), error=rec.unstable, cpg_gait=v.cpg_gait)
 
 
 @dataclass(frozen=True)
