@@ -28,9 +28,10 @@ chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuok
   "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2);
   "reset": a touchdown pulse (phase resetting, Aoi & Tsuchiya): dv_{2+l}/dt += K p_l,
     dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0.
-  scripts/feedback_choice.py scores every form at K = 0.01-0.1 by the push envelope of the
-  walk and the run on tuning conditions (CPG seeds 1000-1003, pushes after 5.5 s), keeping only
-  gains at which no rollout falls, the CPG classifier still names the gait, and each preset
+  scripts/feedback_choice.py scores every form at K = 0.01-0.1 (the pulse 0.05-0.2) by the
+  push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
+  after 5.5 s), keeping only gains at which no rollout falls, the CPG classifier still names
+  the gait, and each preset
   passes its gait's criteria in as many seeds as open loop: "angle" at K = 0.01 scored 115 N s
   (open loop 97.5); "load_antagonist" at K = 0.03 scored 145 but passed the criteria in 2 of
   8 rollouts (open loop 7), and on the test conditions its walk passed in 1 of 13 and its run

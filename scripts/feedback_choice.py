@@ -17,7 +17,7 @@ own state and pushes after 6 s, and the tests CPG seeds 10-19):
   just below their bounds);
 - score: the sum over presets and CPG seeds of the smallest impulse survived over the four
   push phases, forwards plus backwards (envs.robustness.push_envelope); admissible only when
-  the two conditions above hold for every preset and seed.
+  the three conditions above hold for every preset and seed.
 The recommended gain is the best-scoring admissible candidate with K > 0 (the open loop's
 score is printed beside it: feedback is recommended only as "the best closed loop", not as
 better than open loop unless the numbers say so). Writes cpg/feedback_gains.json (read by

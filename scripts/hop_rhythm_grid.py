@@ -1,7 +1,8 @@
 """Is the hop's height the network's rhythm or the body's? The paper's hop weights over a grid
 of (I_app, phi), each driving the body through the committed controller from tuning CPG states.
 
-    python scripts/hop_rhythm_grid.py [--seeds 1000,1001] [--workers 2] [--out out/hop_rhythm_grid.csv]
+    python scripts/hop_rhythm_grid.py [--seeds 1000,1001] [--workers 2]
+                                      [--out out/hop_rhythm_grid.csv]
 
 I_app (the cells' drive) and phi (their recovery rate) set the period and the burst's share of
 it; the weights (Table 2's hop row) keep the four cells in phase. For each point and CPG seed
@@ -66,10 +67,10 @@ def main(argv=None) -> int:
               f"apex {r.get('apex_cm')} cm, {r.get('speed_mps')} m/s, "
               f"stride {r.get('stride_period_s')} s, CV {r.get('stride_cv')}")
     standing = [r for r in rows if not r["fell"] and r["cpg_gait"] == "hop"
-                and r.get("apex_cm") is not None]
+                and r["physical_gait"] == "hop" and r.get("apex_cm") is not None]
     if standing:
         best = max(standing, key=lambda r: r["apex_cm"])
-        print(f"highest hop the CPG names a hop, without a fall: {best['apex_cm']} cm at I_app "
+        print(f"highest hop both classifiers name a hop, no fall: {best['apex_cm']} cm at I_app "
               f"{best['i_app']}, phi {best['phi']} (seed {best['cpg_seed']}; "
               f"{best['speed_mps']} m/s); {len(standing)} of {len(rows)} rollouts")
     out = Path(a.out)

@@ -370,6 +370,20 @@ def test_the_closed_loop_tuning_conditions_keep_the_loop_the_chain_was_tuned_in(
         t = condition_trial("walk", tuple(params_array(CONTROL)), c)
         assert (t.feedback_form, t.feedback) == ("angle", 0.01)
     assert condition_trial("walk", (), tuning_conditions(1)[0]).feedback == 0.0
+    # ... and the trial's rollout is given that pathway (not the recommended one).
+    import cpgbiped.envs.simulation.rollout as ro
+    from cpgbiped.envs.simulation.trials import run_control_trial
+
+    real, seen = ro.rollout, {}
+
+    def spy(*args, **kw):
+        seen.update(kw)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(ro, "rollout", spy)
+    run_control_trial(condition_trial("walk", tuple(params_array(CONTROL)), closed[0]), 0.5,
+                      settle_s=0.5)
+    assert (seen["feedback_form"], seen["feedback"]) == ("angle", 0.01)
 
 
 def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():

@@ -1197,7 +1197,8 @@ def build_parser() -> argparse.ArgumentParser:
         --trials perturbations drawn from the seed (random initial CPG state, friction x0.7-1.3,
         a 2-6 N s push). Objectives: |Fr - Fr*|, cost of transport (walk, run) or work per
         stride / (m g L) (jump, hop), fraction of perturbation trials failed; constraint: the
-        unperturbed rollout is the gait, without a fall. The first generation holds the
+        unperturbed rollout is the gait, by the contacts and by the CPG classifier, without a
+        fall. The first generation holds the
         paper's row. Rollouts run in one process per core (--workers), or on Dask (--dask);
         the same seed gives the same result either way. Writes DIR/<gait>_physics.json (read
         by check-pareto), DIR/<gait>_physics_population.csv, DIR/<gait>_physics_pareto.csv and
@@ -1212,7 +1213,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--physics", action="store_true",
                     help="score (w_a, w_b, w_c, I_app, phi) by rollouts of the biped: objectives "
                          "|Fr - Fr*|, cost of transport (work per stride for jump and hop), "
-                         "fraction of perturbation trials failed; constraint: the gait, no fall")
+                         "fraction of perturbation trials failed; constraint: the gait (by the "
+                         "contacts and by the CPG classifier), no fall")
     sp.add_argument("--froude", type=finite_arg, default=None, metavar="FR",
                     help="--physics: target Froude number (default walk 0.25, run 0.5, jump and "
                          "hop 0.02)")

@@ -15,7 +15,8 @@ drive down to 0.1, and the run, which swings on it, could no longer lift a leg.
 Conditions. Every candidate drives each named preset under every tuning condition
 (:func:`tuning_conditions`): a random initial CPG state drawn from a seed of 1000 or more,
 some with another floor friction or a horizontal push on the torso; from the ninth on, the
-walk driven by another walk network or the loop closed (:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's.
+walk driven by another walk network or the loop closed
+(:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's.
 The tests and the README report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
@@ -159,10 +160,10 @@ def extensor_overlap(gait: str, seed: int, t0_s: float = 0.5, t1_s: float = 3.0)
                                                       * (e[:, 1] ** 2).mean()))
 
 
-# The Morris-Lecar feedback pathway and gain of the closed-loop tuning conditions (9-16): the
-# recommended choice of cpg/feedback_gains.json when the committed chain of tuning runs was
-# made (Taga's gated thigh angle, K = 0.01). Frozen here so that every recorded run of the chain
-# replays with the loop it was tuned in, whatever the recommended choice later becomes.
+# The Morris-Lecar feedback pathway and gain of the closed-loop tuning conditions (10, 12, 14
+# and 16): the recommended choice of cpg/feedback_gains.json when the committed chain of tuning
+# runs was made (Taga's gated thigh angle, K = 0.01). Frozen here so that every recorded run of
+# the chain replays with the loop it was tuned in, whatever the recommended choice becomes.
 TUNING_FEEDBACK = ("angle", 0.01)
 
 
@@ -228,7 +229,8 @@ def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
                         friction_scale=cond.get("friction_scale", 1.0), push=cond.get("push"),
                         weights=None if w is None else tuple(w),
                         feedback=cond.get("feedback", 0.0), network=cond.get("network", "ml"),
-                        feedback_form=TUNING_FEEDBACK[0] if cond.get("feedback") else None)
+                        feedback_form=TUNING_FEEDBACK[0] if cond.get("feedback")
+                        and cond.get("network", "ml") == "ml" else None)
 
 
 def check_gaits(text: str) -> tuple[str, ...]:

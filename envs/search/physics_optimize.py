@@ -34,7 +34,7 @@ from cpgbiped.envs.search.physics_search import (FROUDE_TARGET, I_APP_BOUNDS, OB
                              initial_population, paper_point, trial_failed)
 
 METRICS = ("froude", "speed_mps", "cost_of_transport", "work_per_stride_J", "duty", "flight",
-           "stride_period_s", "apex_height_m", "physical_gait", "fell")
+           "stride_period_s", "apex_height_m", "physical_gait", "cpg_gait", "fell")
 
 
 def checkpoint_name(gait: str) -> str:
@@ -93,7 +93,9 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
     pop = slice(n + 1, None)
     if not points:
         raise InputError(f"no feasible point for {gait}: all {len(problem.archive_X)} points "
-                         f"evaluated fall or make another gait; raise --pop or --gens")
+                         f"evaluated fall or make another gait (by the contacts or the CPG "
+                         f"classifier, which needs 3 CPG cycles in the window); raise --pop, "
+                         f"--gens or --seconds")
     k = choose(points)
     front = {
         "n_points": n, "n_evaluated": int(len(problem.archive_X)),
@@ -119,7 +121,7 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
         "wall_s": round(time.perf_counter() - t0, 3),
     }
     head = [*VARIABLES, *OBJECTIVES, "constraint", "froude", "speed_mps", "cost_of_transport",
-            "duty", "flight", "physical_gait", "fell"]
+            "duty", "flight", "physical_gait", "cpg_gait", "fell"]
     rows = lambda X, F, G, T: [  # noqa: E731
         [*np.round(x, 6), *np.round(f, 6), round(float(g), 6),
          *[t[0].as_dict()[c] for c in head[len(VARIABLES) + len(OBJECTIVES) + 1:]]]

@@ -61,6 +61,9 @@ PHI_BOUNDS = (0.12, 0.5)
 FROUDE_TARGET = {"walk": 0.25, "run": 0.5, "jump": 0.02, "hop": 0.02}
 COST_OF_TRANSPORT_GAITS = ("walk", "run")
 IN_PLACE_COST = 10.0
+# The constraint's terms (:func:`violation`), named in checkpoints so that a run resumes only a
+# search scored the same way.
+CONSTRAINT = "fall+physical_gait+cpg_gait"
 FRICTION_RANGE = (0.7, 1.3)
 PUSH_NS = (2.0, 6.0)  # N s: 0.1-0.3 m/s to the 21 kg body
 
@@ -143,6 +146,9 @@ def violation(gait: str, r: TrialResult, total_s: float) -> float:
 
 
 def trial_failed(gait: str, r: TrialResult) -> bool:
+    """A perturbation trial fails when the body falls or its contacts name another gait; the
+    CPG's own gait is the constraint's (the unperturbed rollout), not asked again here: a push
+    or a friction changes what the body does, not the network's pattern (open loop)."""
     return bool(r.fell or r.physical_gait != gait)
 
 
@@ -183,6 +189,12 @@ class PhysicsGaitProblem(Problem):
     @property
     def objective_names(self) -> list[str]:
         return list(OBJECTIVES)
+
+    def resume_key(self) -> dict:
+        """What a checkpoint must share with this run beyond its settings: the constraint's
+        definition (since 2026-12-04 the CPG classifier's gait is part of it; a checkpoint
+        written before scored its points without it and is not resumed)."""
+        return {"constraint": CONSTRAINT}
 
     def evaluate_points(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray, list]:
         """(F (P, 3), G (P,), per-point trial results) of parameter vectors X (P, 5)."""

@@ -67,7 +67,7 @@ class TrialResult:
     stride_period_s: float
     apex_height_m: float
     error: str | None = None
-    cpg_gait: str | None = None  # the gait the CPG classifier names from the cells (None: not measured)
+    cpg_gait: str | None = None  # the CPG classifier's gait from the cells (None: not measured)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -83,7 +83,8 @@ def quiet_worker() -> None:
 
 def _failed(why: str) -> TrialResult:
     nan = float("nan")
-    return TrialResult(True, 0.0, "none", nan, nan, nan, nan, nan, nan, nan, nan, why)
+    return TrialResult(True, 0.0, "none", nan, nan, nan, nan, nan, nan, nan, nan, why,
+                       cpg_gait="none")
 
 
 def _num(x) -> float:
