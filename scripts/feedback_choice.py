@@ -53,7 +53,6 @@ CHOICE_PUSH_AFTER_S = 5.5
 
 def evaluate(job):
     kind, preset, form, K, seed = job
-    from cpgbiped.cpg.gaits import classify
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.experiments.robustness import push_envelope
     from cpgbiped.envs.gaits.criteria import SETTLE_S
@@ -63,14 +62,18 @@ def evaluate(job):
     net = build(kind, preset, seed=seed)
     ml_form = form if kind == "ml" else None
     rec = rollout(net, 22.0, poses=False, feedback=K, feedback_form=ml_form)
-    steady = rec.t >= 2.0
-    named = classify(rec.t[steady], rec.cpg_v[steady])[0] if steady.sum() > 16 else "none"
-    passed = bool(measure_recording(net, preset, rec, SETTLE_S).summary()["passed"])
+    s = measure_recording(net, preset, rec, SETTLE_S).summary()  # CPG gait and criteria
     env = push_envelope(net, K, after_s=CHOICE_PUSH_AFTER_S, form=ml_form)
     return {"network": kind, "preset": preset, "form": form, "gain": K, "cpg_seed": seed,
-            "fell": rec.fell_at is not None, "cpg_gait": named, "criteria_passed": passed,
+            "fell": rec.fell_at is not None, "cpg_gait": s["cpg_gait"],
+            "criteria_passed": bool(s["passed"]),
             "forward_ns": env["forward"], "backward_ns": env["backward"],
             "score": min(env["forward"]) + min(env["backward"])}
+
+
+def criteria_passes(rows, presets) -> dict:
+    """Per preset, in how many of ``rows`` the unperturbed rollout passed its gait's criteria."""
+    return {p: sum(r["criteria_passed"] for r in rows if r["preset"] == p) for p in presets}
 
 
 def main(argv=None) -> int:
@@ -105,18 +108,16 @@ def main(argv=None) -> int:
         table = []
         named_open = {(r["preset"], r["cpg_seed"]): r["cpg_gait"]
                       for r in by[("open loop", 0.0)]}
-        passed_open = {p: sum(r["criteria_passed"] for r in by[("open loop", 0.0)]
-                              if r["preset"] == p) for p in PRESETS[kind]}
+        passed_open = criteria_passes(by[("open loop", 0.0)], PRESETS[kind])
         for (form, K), rs in by.items():
+            passed = criteria_passes(rs, PRESETS[kind])
             ok = all(not r["fell"] and r["cpg_gait"] == named_open[(r["preset"], r["cpg_seed"])]
-                     for r in rs) and all(
-                sum(r["criteria_passed"] for r in rs if r["preset"] == p) >= passed_open[p]
-                for p in PRESETS[kind])
+                     for r in rs) and all(passed[p] >= passed_open[p] for p in PRESETS[kind])
             table.append({"form": form, "gain": K, "admissible": ok,
                           "score_ns": sum(r["score"] for r in rs)})
             print(f"{kind:9s} {form:16s} K={K:<5g} admissible={ok!s:5s} score "
                   f"{table[-1]['score_ns']:5.1f} N s  criteria passed in "
-                  f"{sum(r['criteria_passed'] for r in rs)}/{len(rs)}  "
+                  f"{sum(passed.values())}/{len(rs)}  "
                   + "; ".join(f"{r['preset']}: fwd {r['forward_ns']} back {r['backward_ns']} "
                               f"cpg {r['cpg_gait']}" for r in rs))
         open_loop = next(t for t in table if t["gain"] == 0)

@@ -140,7 +140,7 @@ def violation(gait: str, r: TrialResult, total_s: float) -> float:
         v += 1.0 + (1.0 - min(r.survived_s, total_s) / total_s)
     if r.physical_gait != gait:
         v += 1.0
-    if r.cpg_gait is not None and r.cpg_gait != gait:
+    if r.cpg_gait != gait:
         v += 1.0
     return v
 

@@ -67,7 +67,7 @@ class TrialResult:
     stride_period_s: float
     apex_height_m: float
     error: str | None = None
-    cpg_gait: str | None = None  # the CPG classifier's gait from the cells (None: not measured)
+    cpg_gait: str | None = None  # the CPG classifier's gait from the cells (every producer sets it)
 
     def as_dict(self) -> dict:
         return asdict(self)
