@@ -145,7 +145,7 @@ def test_settings_refuse_bad_input():
 
 
 def test_conditions_can_be_picked_by_number():
-    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-24,
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-28,
     reversed ranges and text are refused."""
     from cpgbiped.envs.search.controller_tuning import condition_ids
 
@@ -153,14 +153,18 @@ def test_conditions_can_be_picked_by_number():
     assert ids == (1, 2, 3, 4, 5, 6, 7, 8, 21, 22, 23, 24)
     s = TuneSettings(("walk",), n_conditions=len(ids), condition_ids=ids)
     every = tuning_conditions(MAX_CONDITIONS)
-    assert s.conditions() == every[:8] + every[20:]
+    assert s.conditions() == every[:8] + every[20:24]
     assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
     assert condition_ids("3,3,1") == (3, 1)
-    for bad in ("0-3", "20-25", "5-2", "a", "1-", ""):
+    for bad in ("0-3", "20-29", "5-2", "a", "1-", ""):
         with pytest.raises(InputError):
             condition_ids(bad)
     with pytest.raises(InputError):
-        TuneSettings(("walk",), n_conditions=1, condition_ids=(25,))
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(29,))
+    # 25-28: pushes of 8 N s both ways, from CPG states of their own
+    big = every[24:28]
+    assert [c["push"][1] for c in big] == [8.0, -8.0, 8.0, -8.0]
+    assert len({c["cpg_seed"] for c in big} | {c["cpg_seed"] for c in every[:24]}) == 28
 
 
 def test_conditions_21_to_24_start_the_walk_network_in_a_jumps_rhythm():
@@ -172,7 +176,7 @@ def test_conditions_21_to_24_start_the_walk_network_in_a_jumps_rhythm():
     from cpgbiped.envs.search.controller_tuning import extensor_overlap
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    for c in conds[20:]:
+    for c in conds[20:24]:
         assert extensor_overlap("walk", c["cpg_seed"]) > 0.4, c
         assert extensor_overlap("walk", c["cpg_seed"], 17.0, 20.0) < 0.05, c
     for c in conds[:16]:
@@ -395,7 +399,7 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 4
+    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 8
     control = tuple(params_array(CONTROL))
     hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
     ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)

@@ -123,7 +123,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 24
+MAX_CONDITIONS = 28
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 # CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
 # starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
@@ -134,6 +134,9 @@ FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests
 # first tuning conditions' open-loop Table 2 walks none does (at most 0.22): a corner tuned
 # without them is paid for nothing it does to the walk's start-up.
 TRANSIENT_SEEDS = (1030, 1037, 1038, 1075)
+# Conditions 25-28: pushes twice the size of the first eight's (8 N s), at two other moments,
+# both ways (issue 21's push envelope): CPG seeds 1040-1043, never a test's.
+BIG_PUSHES = ((1040, (6.3, 8.0)), (1041, (6.3, -8.0)), (1042, (6.8, 8.0)), (1043, (6.8, -8.0)))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -198,7 +201,8 @@ def tuning_conditions(n: int) -> list[dict]:
     out = [{"cpg_seed": FIRST_TUNING_SEED + k,
             **(extra[k] if k < len(extra) else variants[k - len(extra)])}
            for k in range(min(int(n), 20))]
-    return out + [{"cpg_seed": s} for s in TRANSIENT_SEEDS[:max(0, int(n) - 20)]]
+    out += [{"cpg_seed": s} for s in TRANSIENT_SEEDS[:max(0, int(n) - 20)]]
+    return out + [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
 
 
 def condition_ids(text: str) -> tuple[int, ...]:
