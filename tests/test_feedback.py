@@ -122,13 +122,12 @@ def test_tegotae_holds_a_loaded_hopf_leg_in_its_stance_half():
 
 
 def test_the_thigh_angle_pathway_is_gated_by_ground_contact():
-    """Taga form (the Morris-Lecar choice, and the Matsuoka network's): nothing reaches a
+    """Taga form (a Morris-Lecar candidate, and the Matsuoka network's): nothing reaches a
     leg's cells while its foot carries less than LOAD_CONTACT body weights, and the flexor
     receives the opposite of the extensor."""
     from cpgbiped.envs.simulation.biped import body_constants
 
-    assert CHOICE["ml"][0] == "angle"
-    rec = rollout(build("ml", "walk"), 6.0, poses=False, feedback=0.1)
+    rec = rollout(build("ml", "walk"), 6.0, poses=False, feedback=0.1, feedback_form="angle")
     weight = body_constants()[1] * 9.81
     for leg in range(2):
         air = rec.force[:, leg] / weight < LOAD_CONTACT
