@@ -844,7 +844,7 @@ def _largest_inputs(tmp_path) -> dict:
                                          str(MAX_TRIALS), "--workers", cores, "--quiet",
                                          "--out", "o2"],
         "most tuning conditions": ["tune", "--gait", "walk,run,jump,hop", "--pop", "4", "--gens",
-                                   "1", "--seconds", "4", "--conditions", str(MAX_CONDITIONS),
+                                   "1", "--seconds", "5", "--conditions", str(MAX_CONDITIONS),
                                    "--workers", cores, "--quiet", "--out", "o3"],
         "largest result file": ["check-pareto", "big.json", "--first", "1", "--seconds", "1",
                                 "--quiet", "--out", "o5"],

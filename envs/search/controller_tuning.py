@@ -181,8 +181,9 @@ def tuning_conditions(n: int) -> list[dict]:
     "hopf"), whose bursts have another shape (a walk's extensors burst for about 43% of the
     cycle, the Morris-Lecar walk's for 30%), so that the gains serve a rhythm rather than one
     network's waveform. The twenty-first to twenty-fourth start from :data:`TRANSIENT_SEEDS`
-    (the walk network starts in a jump's rhythm); pick them with
-    :attr:`TuneSettings.condition_ids` (``--conditions 1-8,21-24``)."""
+    (the walk network starts in a jump's rhythm), the twenty-fifth to twenty-eighth push the
+    torso by 8 N s (:data:`BIG_PUSHES`); pick them with :attr:`TuneSettings.condition_ids`
+    (``--conditions 1-8,21-24``)."""
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
     extra = [{}, {"friction_scale": 0.8}, {"friction_scale": 1.25}, {"push": (5.5, 4.0)},
