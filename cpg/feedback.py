@@ -17,8 +17,9 @@ Cells in the order LF, RF, LE, RE (flexor and extensor of the left and right ank
 l its flexor is cell l and its extensor cell 2 + l. One gain K >= 0 scales every pathway.
 
 Morris-Lecar: four pathways were built and measured (input currents in model units); the
-chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuoka network:
-  "angle" (chosen): contact-gated thigh angle, a current into each cell of leg l:
+chosen one is ``CHOICE["ml"]``, read from the data file below ("load_antagonist" at K = 0.01
+since the walk corner's push stages of 2026-12-04; Taga's "angle" at K = 0.01 before):
+  "angle": contact-gated thigh angle, a current into each cell of leg l:
     dv_l/dt += K (-q_l / THETA_REF),    dv_{2+l}/dt += -K (-q_l / THETA_REF)
     (a stance leg carried behind the hip depolarises its flexor and hyperpolarises its
     extensor: time to swing; a leg placed ahead does the reverse);
@@ -32,11 +33,14 @@ chosen one (``CHOICE["ml"]``, the data file below) is Taga's, as for the Matsuok
   push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
   after 5.5 s), keeping only gains at which no rollout falls, the CPG classifier still names
   the gait, and each preset
-  passes its gait's criteria in as many seeds as open loop: "angle" at K = 0.01 scored 115 N s
-  (open loop 97.5); "load_antagonist" at K = 0.03 scored 145 but passed the criteria in 2 of
-  8 rollouts (open loop 7), and on the test conditions its walk passed in 1 of 13 and its run
-  in none; at K = 0.1 the load forms and the reset turn the network's walk into a skip or
-  none (cpg/feedback_gains.json holds every candidate's numbers).
+  passes its gait's criteria in as many seeds as open loop. On today's gains
+  "load_antagonist" at K = 0.01 scores 125 N s (open loop 125, both passing the criteria in 8
+  of 8 rollouts) and "angle" at K = 0.01 127.5 but in 7 of 8 (inadmissible); on the gains
+  before the walk's push stages "angle" at K = 0.01 scored 115 (open loop 97.5) and
+  "load_antagonist" at K = 0.03 145 but passed the criteria in 2 of 8 rollouts (open loop 7),
+  its walk then passing in 1 of the 13 test conditions and its run in none; at K = 0.1 the
+  load forms and the reset turn the network's walk into a skip or none
+  (cpg/feedback_gains.json holds every candidate's numbers).
 Hopf (Tegotae, Owaki & Ishiguro 2013/2017: each extensor oscillator's phase is pushed by its
 leg's load). With the phase theta_i = atan2(y_i, x_i) (the oscillator's stance half, y > 0,
 is theta in (0, pi); the body's burst, y above the preset's activation centre, lies inside it):
@@ -77,8 +81,8 @@ from .hopf import _rhs4 as _hopf_rhs
 from .integrate import _ml_f
 
 KIND_ML, KIND_HOPF, KIND_MATSUOKA = 0, 1, 2
-# The alternative Morris-Lecar form, measured against the chosen one (scripts/feedback_choice.py):
-# each flexor also receives -K (n_l - 1/2).
+# The Morris-Lecar load form with its antagonist (the choice of scripts/feedback_choice.py
+# since 2026-12-04): each flexor also receives -K (n_l - 1/2).
 KIND_ML_ANTAGONIST = 3
 # ... and the Morris-Lecar cells with Taga's contact-gated thigh angle (the Matsuoka form).
 KIND_ML_ANGLE = 4

@@ -89,12 +89,14 @@ prev="$OUT/rk/gains.json"
 RUN_FREE=$(python3 scripts/run_soft_knee.py --free)
 stage rs1 --gait run --only "$RUN_FREE" --conditions 4 --seconds 16 --gens 60 --pop 16 --sigma 0.15 --seed 107 --shortfall-weight 12
 stage rs2 --gait run --only "$RUN_FREE" --conditions 8 --seconds 20 --gens 60 --pop 16 --sigma 0.08 --seed 108 --shortfall-weight 12
-# The walk's pushes (README, "Feedback into the CPG": the push envelope): the walk corner over
+# The walk's pushes (README, Status, "The walk's pushes"): the walk corner over
 # the first 16 conditions and four pushes of 8 N s (conditions 25-28), the walk guarded against
 # the gains before it; then the same corner scored on the walk, the run and the jump at once,
 # all three guarded against the gains before wp1 (the walk corner's gains blend into the run's
 # and the jump's: after wp1 alone the run fell from one more tuning state, CPG seed 1013 at
-# 2.4 s). About 22 minutes.
+# 2.4 s). About 22 minutes. (The committed file's provenance records these two runs as they
+# were made: from the committed gains of then, written to out/wp1 and out/wp3, the guard's
+# gains a copy of them; the same arguments and seeds, so the same result.)
 rs2_end="$prev"
 stage wp1 --gait walk --guard walk --conditions 1-16,25-28 --seconds 20 --gens 30 --pop 16 --sigma 0.03 --seed 130
 stage wp2 --gait walk,run,jump --only 'alternating.*' --guard walk,run,jump --guard-gains "$rs2_end" --conditions 1-16,25-28 --seconds 20 --gens 20 --pop 16 --sigma 0.02 --seed 132

@@ -387,7 +387,7 @@ def test_secondary_physics_options_are_checked_first(tmp_path, args, says):
 # command is in the file. The body judges them here from the Table 3 state, which the
 # selection never used.
 PHYSICS_SECONDARY = Path(__file__).parent / "data" / "secondary_physics.json"
-PHYSICS_SHORTFALL: dict = {}  # both confirmed since the run's stance stages (rs1, rs2)
+PHYSICS_SHORTFALL: dict = {}  # both confirmed (file re-chosen after wp1, wp2; since rs1, rs2)
 
 
 @pytest.mark.parametrize("target,source", [
