@@ -161,10 +161,13 @@ def test_conditions_can_be_picked_by_number():
             condition_ids(bad)
     with pytest.raises(InputError):
         TuneSettings(("walk",), n_conditions=1, condition_ids=(29,))
-    # 25-28: pushes of 8 N s both ways, from CPG states of their own
-    big = every[24:28]
-    assert [c["push"][1] for c in big] == [8.0, -8.0, 8.0, -8.0]
-    assert len({c["cpg_seed"] for c in big} | {c["cpg_seed"] for c in every[:24]}) == 28
+    # 25-28: pushes twice the largest of the conditions before them, as many forwards as
+    # backwards, each from a CPG state of its own
+    big = [c["push"] for c in every[24:28]]
+    before = max(abs(c["push"][1]) for c in every[:24] if "push" in c)
+    assert all(abs(i) == 2 * before for _, i in big)
+    assert sum(i > 0 for _, i in big) == sum(i < 0 for _, i in big) == 2
+    assert len({c["cpg_seed"] for c in every}) == len(every) == 28
 
 
 def test_conditions_21_to_24_start_the_walk_network_in_a_jumps_rhythm():
