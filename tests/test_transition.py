@@ -75,6 +75,21 @@ def test_the_window_before_the_change_holds_whole_cycles_of_a():
     assert before_cycles(100.0, 0.721) == 5
 
 
+def test_seed_starts_the_network_from_that_random_state():
+    """--seed S: A starts from the random CPG state of seed S (as validate --seed does), so up
+    to the change the rollout is a plain rollout of build(kind, A, seed=S), and not the Table 3
+    state's."""
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    res, rec, *_ = transition("ml", "walk", "run", 4.0, 0.0, 5.0, seed=3001)
+    assert res["cpg_seed"] == 3001
+    plain = rollout(build("ml", "walk", seed=3001), 3.9, poses=False, stop_on_fall=False)
+    table3 = rollout(build("ml", "walk"), 3.9, poses=False, stop_on_fall=False)
+    n = len(plain.t)
+    assert np.allclose(rec.drive[:n], plain.drive, atol=1e-9)
+    assert not np.allclose(rec.drive[:n], table3.drive, atol=1e-3)
+
+
 def test_transition_json_and_pictures(tmp_path):
     out = tmp_path / "t.mp4"
     r = _cli("transition", "--from", "jump", "--to", "hop", "--at", "6", "--seconds", "12",
@@ -99,6 +114,7 @@ def test_transition_json_and_pictures(tmp_path):
     (("transition", "--from", "walk", "--to", "run", "--at", "12", "--seconds", "10"), "outside"),
     (("transition", "--from", "walk", "--to", "run", "--at", "1"), "outside"),
     (("transition", "--from", "walk", "--to", "run", "--ramp", "-1"), ">= 0"),
+    (("transition", "--from", "walk", "--to", "run", "--seed", "x"), "--seed"),
     (("transition", "--from", "walk", "--to", "run", "--network", "matsuoka"), "invalid choice"),
     (("transition", "--from", "walk", "--to", "run", "--network", "hopf", "--feedback"),
      "Morris-Lecar"),

@@ -804,8 +804,9 @@ def cmd_transition(a) -> int:
     out_file(a.rrd, "--rrd", ".rrd")
     src, dst = getattr(a, "from"), a.to
     res, rec, net, to = transition(a.network, src, dst, a.at, a.ramp, seconds, K,
-                                   poses=bool(a.out or a.rrd))
+                                   poses=bool(a.out or a.rrd), seed=a.seed)
     label = (f"{a.network} {src} -> {dst} at {a.at:g} s" + (f" over {a.ramp:g} s" if a.ramp else "")
+             + (f", CPG seed {a.seed}" if a.seed is not None else "")
              + (f", feedback K = {K:g}" if K else ""))
     marks = [(a.at, "change")] + ([(a.at + a.ramp, "end of ramp")] if a.ramp else [])
     written = []
@@ -1076,7 +1077,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("transition", cmd_transition, "change the network's parameters in mid-run", """\
-        The network starts as preset --from (Table 3 state) and its parameters move to
+        The network starts as preset --from (Table 3 state, or --seed's random state) and
+        its parameters move to
         --to's at --at s (simulation time from the start, settling included): a step, or a
         linear ramp over --ramp s. The CPG's state carries across; the controller is not
         told. Metrics before the change, and after the physical gait has settled (sliding
@@ -1095,6 +1097,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "walk <-> run or jump <-> hop, + 30 s across them, where the network "
                          "takes longer to lock)")
     sp.add_argument("--network", default="ml", choices=("ml", "hopf"))
+    sp.add_argument("--seed", type=seed_arg, default=None,
+                    help="start --from's network from the random initial CPG state of this "
+                         "seed (default: its Table 3 state)")
     feedback_option(sp, " (Morris-Lecar)")
     sp.add_argument("--width", type=count_arg(1), default=640)
     sp.add_argument("--height", type=count_arg(1), default=480)

@@ -1,6 +1,7 @@
 """Gait transitions in physics: the network's parameters change in mid-run and the body follows.
 
-The network starts as preset A (its Table 3 state) and, at ``at_s`` (simulation time from the
+The network starts as preset A (its Table 3 state, or a random one drawn from a CPG seed) and,
+at ``at_s`` (simulation time from the
 start, settling included), its parameters move to preset B's: a step (ramp 0) or a linear ramp
 over ``ramp_s`` seconds (:class:`cpg.integrate.Schedule`). The CPG's state carries across the
 change; nothing is reset, and the controller is not told (it never sees a name).
@@ -125,10 +126,13 @@ def extensor_synchrony(t_s, activation, at_s: float, period_s: float,
 
 
 def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0,
-               seconds: float = 20.0, feedback: float = 0.0, poses: bool = False):
-    """(result dict, recording, the network A, the network B)."""
+               seconds: float = 20.0, feedback: float = 0.0, poses: bool = False,
+               seed: int | None = None):
+    """(result dict, recording, the network A, the network B). ``seed``: A starts from the
+    random initial CPG state drawn from this seed (None: its Table 3 state); B lends only its
+    parameters, so its state is never used."""
     seconds = check_transition(kind, a, b, at_s, ramp_s, seconds)
-    net, to = build(kind, a), build(kind, b)
+    net, to = build(kind, a, seed=seed), build(kind, b)
     rec = rollout(net, seconds, to=to, change=Schedule.change(at_s, ramp_s), poses=poses,
                   stop_on_fall=False, feedback=feedback)
     fell_at = rec.fell_at
@@ -151,7 +155,8 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
             break
     start = at_s + (settled if settled is not None else len(slides)) * T
     after = window_summary(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
-    res = {"network": kind, "from": a, "to": b, "at_s": float(at_s), "ramp_s": float(ramp_s),
+    res = {"network": kind, "from": a, "to": b, "cpg_seed": seed, "at_s": float(at_s),
+           "ramp_s": float(ramp_s),
            "seconds": seconds, "feedback_gain": rec.feedback_gain, "cpg_period_to_s": T,
            "before": before, "before_cycles": n_before,
            "before_from_settling": from_settling, "after": after,
