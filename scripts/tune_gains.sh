@@ -100,6 +100,10 @@ stage rs2 --gait run --only "$RUN_FREE" --conditions 8 --seconds 20 --gens 60 --
 rs2_end="$prev"
 stage wp1 --gait walk --guard walk --conditions 1-16,25-28 --seconds 20 --gens 30 --pop 16 --sigma 0.03 --seed 130
 stage wp2 --gait walk,run,jump --only 'alternating.*' --guard walk,run,jump --guard-gains "$rs2_end" --conditions 1-16,25-28 --seconds 20 --gens 20 --pop 16 --sigma 0.02 --seed 132
+# The walk's stance knee (README, "The walk's stance knee"): set by hand after a sweep and a
+# rule on tuning states: the walk's duty sat at the criterion's edge.
+python3 scripts/walk_crouch.py "$prev" "$OUT"
+prev="$OUT/wc/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys
