@@ -39,8 +39,9 @@ at K = 0.01 between them):
   "load_antagonist" at K = 0.01 140 (8 of 8); at K = 0.03 "load_antagonist" 162.5 and
   "angle" 200 but passing in 0 and 4 of 8 (inadmissible). Between the walk's push stages and
   its stance knee "load_antagonist" at K = 0.01 scored 125 (open loop 125) and "angle" at
-  K = 0.01 127.5 but in 7 of 8 (inadmissible); on the gains before the walk's push stages "angle" at K = 0.01 scored 115 (open loop 97.5) and
-  "load_antagonist" at K = 0.03 145 but passed the criteria in 2 of 8 rollouts (open loop 7),
+  K = 0.01 127.5 but in 7 of 8 (inadmissible); on the gains before the walk's push stages
+  "angle" at K = 0.01 scored 115 (open loop 97.5) and "load_antagonist" at K = 0.03 145 but
+  passed the criteria in 2 of 8 rollouts (open loop 7),
   its walk then passing in 1 of the 13 test conditions and its run in none; at K = 0.1 the
   load forms and the reset turn the network's walk into a skip or none
   (cpg/feedback_gains.json holds every candidate's numbers).
@@ -85,7 +86,8 @@ from .integrate import _ml_f
 
 KIND_ML, KIND_HOPF, KIND_MATSUOKA = 0, 1, 2
 # The Morris-Lecar load form with its antagonist (the choice of scripts/feedback_choice.py
-# since 2026-12-04): each flexor also receives -K (n_l - 1/2).
+# between the walk's push stages and its stance knee, 2026-12-04): each flexor also receives
+# -K (n_l - 1/2).
 KIND_ML_ANTAGONIST = 3
 # ... and the Morris-Lecar cells with Taga's contact-gated thigh angle (the Matsuoka form).
 KIND_ML_ANGLE = 4

@@ -13,16 +13,19 @@ A transition counts as switched as the tests count it: no fall, the physical gai
 change is A, and the settled gait after it is B (``cycles_to_switch`` set; the tests also ask
 for at most 4 CPG cycles, reported here as "within 4"). Seeds 3000 and up are neither tuning
 conditions (1000-1099) nor the tests' (10-19). Prints one row per pair and way: switched,
-within 4 cycles, the walk (A) named before the change, fell.
+within 4 cycles, A named before the change, fell.
 """
 import argparse
+import itertools
 import json
 import os
 from concurrent.futures import ProcessPoolExecutor
 
-IN_FAMILY = (("walk", "run"), ("run", "walk"), ("jump", "hop"), ("hop", "jump"))
-CROSS = tuple((a, b) for a in ("walk", "run", "jump", "hop") for b in ("walk", "run", "jump", "hop")
-              if a != b and (a, b) not in IN_FAMILY)
+from cpgbiped.envs.experiments.transition import IN_FAMILY as _FAMILY
+
+PAIRS = tuple(itertools.permutations(("walk", "run", "jump", "hop"), 2))
+IN_FAMILY = tuple(p for p in PAIRS if p in _FAMILY)  # walk-run, run-walk, jump-hop, hop-jump
+CROSS = tuple(p for p in PAIRS if p not in _FAMILY)
 
 
 def one(job):

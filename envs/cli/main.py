@@ -1078,8 +1078,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sp = add("transition", cmd_transition, "change the network's parameters in mid-run", """\
         The network starts as preset --from (Table 3 state, or --seed's random state) and
-        its parameters move to
-        --to's at --at s (simulation time from the start, settling included): a step, or a
+        its parameters move to --to's at --at s (simulation time from the start, settling included): a step, or a
         linear ramp over --ramp s. The CPG's state carries across; the controller is not
         told. Metrics before the change, and after the physical gait has settled (sliding
         windows of 3 CPG cycles; cycles_to_switch counts the CPG cycles from the change until

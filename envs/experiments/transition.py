@@ -1,9 +1,8 @@
 """Gait transitions in physics: the network's parameters change in mid-run and the body follows.
 
 The network starts as preset A (its Table 3 state, or a random one drawn from a CPG seed) and,
-at ``at_s`` (simulation time from the
-start, settling included), its parameters move to preset B's: a step (ramp 0) or a linear ramp
-over ``ramp_s`` seconds (:class:`cpg.integrate.Schedule`). The CPG's state carries across the
+at ``at_s`` (simulation time from the start, settling included), its parameters move to preset
+B's: a step (ramp 0) or a linear ramp over ``ramp_s`` seconds (:class:`cpg.integrate.Schedule`). The CPG's state carries across the
 change; nothing is reset, and the controller is not told (it never sees a name).
 
 Windows, all measured from the foot contacts (:func:`cpgbiped.envs.gaits.validate.measure_recording`):
