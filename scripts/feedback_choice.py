@@ -55,6 +55,7 @@ def evaluate(job):
     kind, preset, form, K, seed = job
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.experiments.robustness import push_envelope
+    from cpgbiped.envs.simulation.rollout import PUSH_TICK_S
     from cpgbiped.envs.gaits.criteria import SETTLE_S
     from cpgbiped.envs.gaits.validate import measure_recording
     from cpgbiped.envs.simulation.rollout import rollout
@@ -63,7 +64,8 @@ def evaluate(job):
     ml_form = form if kind == "ml" else None
     rec = rollout(net, 22.0, poses=False, feedback=K, feedback_form=ml_form)
     s = measure_recording(net, preset, rec, SETTLE_S).summary()  # CPG gait and criteria
-    env = push_envelope(net, K, after_s=CHOICE_PUSH_AFTER_S, form=ml_form)
+    env = push_envelope(net, K, after_s=CHOICE_PUSH_AFTER_S, form=ml_form,
+                        push_s=PUSH_TICK_S)  # the blow its result file was scored with
     return {"network": kind, "preset": preset, "form": form, "gain": K, "cpg_seed": seed,
             "fell": rec.fell_at is not None, "cpg_gait": s["cpg_gait"],
             "criteria_passed": bool(s["passed"]),

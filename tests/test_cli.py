@@ -48,6 +48,9 @@ def test_help_reads_like_a_manual():
     (["tune", "--gait", "walk", "--only", "synchronous.push"], "names no gain"),
     (["tune", "--gait", "jump", "--guard", "walk"], "must be scored too"),
     (["tune", "--gait", "walk", "--guard", "walk", "--guard-gains", "nope.json"], "nope.json"),
+    (["validate", "--push", "6", "5", "--push-s", "0.001"], "at least one control tick"),
+    (["robustness", "--push-s", "nan"], "must be a number of seconds in [0.004, 1]"),
+    (["log", "--rrd", "x.rrd", "--push", "6", "5", "--push-s", "2"], "[0.004, 1]"),
 ])
 def test_bad_input_one_line_nonzero(args, msg):
     r = run(*args)
@@ -86,3 +89,23 @@ def test_optimize_unreadable_checkpoint(tmp_path):
             "--out", str(tmp_path))
     assert r.returncode == 2 and "unreadable checkpoint" in r.stderr
     assert not (tmp_path / "hop.json").exists()
+
+
+def test_the_push_duration_bounds_the_parser_restates_are_the_library_s():
+    """The CLI parses --push-s without importing MuJoCo, so it restates the bounds and the
+    default; they must be the rollout's and the envelope's own."""
+    from cpgbiped.envs.cli import main
+    from cpgbiped.envs.experiments.robustness import PUSH_S
+    from cpgbiped.envs.simulation.rollout import MAX_PUSH_S, PUSH_TICK_S
+
+    assert (main.PUSH_TICK_S, main.MAX_PUSH_S, main.PUSH_S) == (PUSH_TICK_S, MAX_PUSH_S, PUSH_S)
+
+
+def test_a_push_is_its_impulse_spread_over_whole_control_ticks():
+    """(time, impulse, duration) -> first tick, ticks, force: force x ticks x tick = impulse,
+    the duration rounded to whole 4 ms ticks; one tick when no duration is given."""
+    from cpgbiped.envs.simulation.rollout import check_push, push_ticks
+
+    assert push_ticks(check_push((6.0, 5.0, 0.2), 10.0), 0.004) == pytest.approx((1500, 50, 25.0))
+    assert push_ticks(check_push((6.0, -5.0), 10.0), 0.004) == pytest.approx((1500, 1, -1250.0))
+    assert push_ticks(None, 0.004) == (-1, 0, 0.0)

@@ -213,8 +213,9 @@ def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fa
     sp = stride_phase(net, 0.0)
     assert sp.t0_s == pytest.approx(g["push"]["stride"]["t0_s"])
     nxt = IMPULSE_LADDER_NS[IMPULSE_LADDER_NS.index(best) + 1] if best else IMPULSE_LADDER_NS[0]
-    fell = lambda imp: rollout(net, sp.t0_s + HOLD_S, push=(sp.t0_s, imp),  # noqa: E731
-                               poses=False).fell_at is not None
+    assert res["push_s"] == 0.2  # SCONE's perturbed-gait tutorial holds its push 0.2 s
+    fell = lambda imp: rollout(net, sp.t0_s + HOLD_S,  # noqa: E731
+                               push=(sp.t0_s, imp, res["push_s"]), poses=False).fell_at is not None
     assert (not best or not fell(best)) and fell(nxt)
 
 
@@ -233,35 +234,51 @@ def test_the_jump_survives_the_test_conditions_with_feedback():
     assert fell == 0
 
 
-@pytest.mark.xfail(raises=AssertionError, strict=True,
-                   reason="push envelope with feedback (Taga's thigh angle, K = 0.01, since "
-                          "the walk's stance knee; smallest impulse survived over four stride "
-                          "phases): walk forwards 10 N s (0.48 N s/kg), as open loop; run "
-                          "forwards 5 N s (0.24 N s/kg), as open loop; neither twice the open "
-                          "loop's nor 0.5 N s/kg (10.5 N s)")
-def test_feedback_doubles_the_forward_push_envelope_or_reaches_half_a_newton_second_per_kg():
-    from cpgbiped.envs.experiments.robustness import push_envelope
+# Measured 2026-12-04 (Table 3 state; smallest impulse survived over four stride phases, open
+# loop / Taga's thigh angle at K = 0.01): pushes held 0.2 s as SCONE's tutorial holds them,
+# and blows of the same impulse in one 4 ms control tick (the form of the tuning conditions,
+# and the only form measured until 2026-12-04).
+_ENVELOPE_SHORTFALLS = {
+    ("run", "forward", "push"): "5 N s open loop, 2.5 with feedback (0.12 N s/kg)",
+    ("run", "backward", "push"): "2.5 N s open loop and with feedback (0.12 N s/kg): after 5 N s "
+                                 "backwards in mid-stance the landing brakes the run to 0.8 "
+                                 "m/s, three strides later it overshoots to 1.85 m/s and a "
+                                 "quick, mistimed step fells it",
+    ("walk", "forward", "blow"): "10 N s open loop and with feedback (0.48 N s/kg): the blow "
+                                 "lifts the stance foot off the ground",
+    ("run", "forward", "blow"): "5 N s open loop and with feedback (0.24 N s/kg)",
+}
 
+
+def _envelope_cases():
     for preset in ("walk", "run"):
-        net = build("ml", preset)
-        o, c = (min(push_envelope(net, K)["forward"]) for K in (0.0, RECOMMENDED["ml"]))
-        assert c >= 2 * o or c >= 0.5 * 21.0, (preset, o, c)
+        for direction in ("forward", "backward"):
+            for form in ("push", "blow"):
+                why = _ENVELOPE_SHORTFALLS.get((preset, direction, form))
+                marks = [pytest.mark.xfail(raises=AssertionError, strict=True, reason=why)
+                         ] if why else []
+                yield pytest.param(preset, direction, form, marks=marks,
+                                   id=f"{preset}-{direction}-{form}")
 
 
-@pytest.mark.parametrize("preset", ["walk", "run"])
-def test_feedback_doubles_the_backward_push_envelope_or_reaches_half_a_newton_second_per_kg(
-        preset):
-    """Issue 21, backwards: the smallest impulse survived over four stride phases with the
-    recommended feedback is twice the open loop's or at least 0.5 N s/kg of the 21 kg body
-    (measured since the walk's stance knee: the walk 15 N s with feedback and 15 open loop,
-    so it passes by the 0.5 N s/kg clause, which open loop meets too; the run 12.5 with
-    feedback, 7.5 open loop: the thigh angle's feedback lifts its mid-stride envelope from
-    7.5 to 15 N s. Between wp1, wp2 and the stance knee the run's was 5 either way)."""
-    from cpgbiped.envs.experiments.robustness import push_envelope
+@pytest.mark.parametrize("preset,direction,form", list(_envelope_cases()))
+def test_feedback_doubles_the_push_envelope_or_reaches_half_a_newton_second_per_kg(
+        preset, direction, form):
+    """Issue 21: the smallest impulse survived over four stride phases with the recommended
+    feedback is twice the open loop's or at least 0.5 N s/kg of the 21 kg body (10.5 N s),
+    for the walk and the run, forwards and backwards. "push": the force held 0.2 s, as
+    SCONE's perturbed-gait tutorial holds its 100 N (the product's push); "blow": the same
+    impulse in one 4 ms control tick. Measured: the walk with feedback 15 N s forwards and
+    25 backwards (pushes), 10 and 15 (blows); the run's in _ENVELOPE_SHORTFALLS and 12.5
+    backwards (blows, 7.5 open loop)."""
+    from cpgbiped.envs.experiments.robustness import PUSH_S, push_envelope
+    from cpgbiped.envs.simulation.rollout import PUSH_TICK_S
 
     net = build("ml", preset)
-    o, c = (min(push_envelope(net, K)["backward"]) for K in (0.0, RECOMMENDED["ml"]))
-    assert c >= 2 * o or c >= 0.5 * 21.0, (preset, o, c)
+    push_s = PUSH_S if form == "push" else PUSH_TICK_S
+    o, c = (min(push_envelope(net, K, push_s=push_s)[direction])
+            for K in (0.0, RECOMMENDED["ml"]))
+    assert c >= 2 * o or c >= 0.5 * 21.0, (preset, direction, form, o, c)
 
 
 @pytest.mark.parametrize("preset", ["walk", "run", "jump", "hop"])

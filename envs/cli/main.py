@@ -78,6 +78,19 @@ def finite_arg(text: str) -> float:
     return _number(text, -1e300, 1e300, False, "must be a finite number")
 
 
+# A push's duration (envs.simulation.rollout.PUSH_TICK_S, MAX_PUSH_S and
+# envs.experiments.robustness.PUSH_S, restated so that parsing needs no MuJoCo; a test checks
+# they agree): one control tick up to a second; the default SCONE's (Tutorial 4c: 100 N held
+# for 0.2 s).
+PUSH_TICK_S, MAX_PUSH_S, PUSH_S = 0.004, 1.0, 0.2
+
+
+def push_seconds_arg(text: str) -> float:
+    return _number(text, PUSH_TICK_S - 1e-12, MAX_PUSH_S, False,
+                   f"must be a number of seconds in [{PUSH_TICK_S:g}, {MAX_PUSH_S:g}] (the push's "
+                   f"force is held for at least one control tick)")
+
+
 def seed_arg(text: str) -> int:
     try:
         v = int(text)
@@ -616,7 +629,8 @@ def _validation(a, stop_on_fall=True, settle_s=None):
     net.period()  # a network without a rhythm cannot drive the body: one line, before any work
     K = feedback_gain(a, net.kind)
     v = validate(net, a.gait, a.seconds, friction_scale=a.friction_scale,
-                 push=getattr(a, "push", None), stop_on_fall=stop_on_fall,
+                 push=None if getattr(a, "push", None) is None else (*a.push, a.push_s),
+                 stop_on_fall=stop_on_fall,
                  settle_s=SETTLE_S if settle_s is None else settle_s,
                  ankle_drive=not a.no_ankle_drive, feedback=K)
     return v, label + (f", feedback K = {K:g}" if K else "")
@@ -742,7 +756,7 @@ def cmd_robustness(a) -> int:
     net, label = _network(a)
     net.period()
     gains = _gains_to_compare(a, net.kind)
-    res = robustness(net, a.gait, gains)
+    res = robustness(net, a.gait, gains, push_s=a.push_s)
     res["source"] = label
     stem = os.path.join(a.out, f"robustness_{net.kind}_{net.preset}")
     with io.all_or_nothing():  # the table and its picture land together
@@ -751,7 +765,8 @@ def cmd_robustness(a) -> int:
     if a.json:
         print(io.to_json(res))
     else:
-        print(f"{label}: push envelope (impulse survived, N s, at stride phases), friction "
+        print(f"{label}: push envelope (impulse survived, N s, at stride phases; each push "
+              f"held {res['push_s']:g} s), friction "
               f"x0.5/0.7/1.3/2.0 and 8 random CPG states; target {a.gait}")
         print(table(res))
         print(f"wrote {stem}.json, {stem}.png")
@@ -985,6 +1000,16 @@ def build_parser() -> argparse.ArgumentParser:
                         help="also write a rerun recording")
         feedback_option(sp)
 
+    def push_args(sp):
+        sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"),
+                        help="horizontal impulse on the torso at time T_S s (simulation time "
+                             "from the start, settling included) of IMPULSE_NS N s (negative: "
+                             "backwards)")
+        sp.add_argument("--push-s", type=push_seconds_arg, default=PUSH_S, metavar="S",
+                        help=f"how long the push's force is held, s (default {PUSH_S:g}, as "
+                             f"SCONE's perturbed-gait tutorial; {PUSH_TICK_S:g}: one control "
+                             f"tick, a blow)")
+
     sp = add("validate", cmd_validate, "drive the biped with a network and measure the gait", """\
         A network (--network, --preset, --weights; default the Morris-Lecar preset of --gait)
         drives the biped through the one controller, which never sees a gait name. The gait
@@ -995,9 +1020,7 @@ def build_parser() -> argparse.ArgumentParser:
         PASS when the body did not fall, both verdicts name it and its criteria are met.
         Times (--push, fell_at_s) are simulation time from the start, settling included.""")
     rollout_args(sp)
-    sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"),
-                    help="horizontal impulse on the torso at time T_S s (simulation time from "
-                         "the start, settling included) of IMPULSE_NS N s")
+    push_args(sp)
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("matrix", cmd_matrix, "every preset of a network through the one controller", """\
@@ -1039,7 +1062,7 @@ def build_parser() -> argparse.ArgumentParser:
         touchdown/lift-off events and the gait metrics; the default view shows the gait
         diagram above the CPG signals. Open it with 'rerun FILE.rrd'.""")
     rollout_args(sp, rrd_required=True)
-    sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"))
+    push_args(sp)
 
     def network_args(sp):
         network_choice(sp, "the gait checked in the conditions: walk, run, jump or hop "
@@ -1058,6 +1081,10 @@ def build_parser() -> argparse.ArgumentParser:
         side by side. Writes --out/robustness_<network>_<preset>.json and .png (impulse
         survived against the phase of the push).""")
     network_args(sp)
+    sp.add_argument("--push-s", type=push_seconds_arg, default=PUSH_S, metavar="S",
+                    help=f"how long each push's force is held, s (default {PUSH_S:g}, as "
+                         f"SCONE's perturbed-gait tutorial; {PUSH_TICK_S:g}: one control tick, "
+                         f"a blow of the same impulse)")
     sp.add_argument("--out", default="out/robustness", metavar="DIR",
                     help="folder for the JSON and the picture (default out/robustness)")
     sp.add_argument("--json", action="store_true", help="print JSON")

@@ -3,11 +3,15 @@
 For one network (any kind and preset) and one feedback gain K (:mod:`cpg.feedback`; 0 open
 loop), every number from the body, none from the network alone:
 
-- **Pushes.** A horizontal impulse on the torso (one control tick of force) at a phase of the
-  stride, forwards (+) or backwards (-). The stride's phase comes from the unperturbed rollout
+- **Pushes.** A horizontal impulse on the torso at a phase of the stride, forwards (+) or
+  backwards (-): a constant force held for ``PUSH_S`` = 0.2 s, as in SCONE's perturbed-gait
+  tutorial (Tutorial 4c: 100 N for 0.2 s on the pelvis, 20 N s on its 75 kg model; the
+  issue's "about 0.27 N s/kg"). ``push_s`` sets another duration, down to one control tick
+  (4 ms, ``rollout.PUSH_TICK_S``: a blow of the same impulse, the form the controller's
+  tuning conditions and ``scripts/feedback_choice.py`` use). The stride's phase comes from the unperturbed rollout
   with the same K: phase 0 is the first left touchdown at or after ``PUSH_AFTER_S`` (simulation
   time, settling included), the stride period the median of its left touchdown intervals. The
-  impulse climbs ``IMPULSE_LADDER_NS`` until the body falls within ``HOLD_S`` after the push;
+  impulse climbs ``IMPULSE_LADDER_NS`` until the body falls within ``HOLD_S`` of the push's start;
   the envelope at that phase and direction is the largest impulse survived before the first
   fall (0 when the smallest one fells it), in N s and in N s per kg of the body.
 - **Friction.** The floor's friction scaled by each of ``FRICTIONS``.
@@ -33,6 +37,7 @@ from cpgbiped.envs.gaits.criteria import SETTLE_S
 from cpgbiped.envs.gaits.gait_metrics import debounce, edges
 from cpgbiped.envs.simulation.rollout import rollout
 
+PUSH_S = 0.2  # s: how long a push's force is held (SCONE Tutorial 4c)
 PUSH_PHASES = (0.0, 0.25, 0.5, 0.75)
 IMPULSE_LADDER_NS = (2.5, 5.0, 7.5, 10.0, 12.5, 15.0, 20.0, 25.0, 30.0, 40.0)
 PUSH_AFTER_S = 6.0
@@ -71,29 +76,31 @@ def stride_phase(network: Network, K: float, after_s: float = PUSH_AFTER_S,
 
 
 def survives(network: Network, K: float, t_push: float, impulse: float,
-             form: str | None = None) -> bool:
-    rec = rollout(network, t_push + HOLD_S, push=(t_push, impulse), poses=False, feedback=K,
-                  feedback_form=form)
+             form: str | None = None, push_s: float = PUSH_S) -> bool:
+    rec = rollout(network, t_push + HOLD_S, push=(t_push, impulse, push_s),
+                  poses=False, feedback=K, feedback_form=form)
     return rec.fell_at is None and rec.unstable is None
 
 
 def push_envelope(network: Network, K: float, phases=PUSH_PHASES,
                   ladder=IMPULSE_LADDER_NS, after_s: float = PUSH_AFTER_S,
-                  form: str | None = None) -> dict:
+                  form: str | None = None, push_s: float = PUSH_S) -> dict:
     """{"stride": {...}, "forward": [impulse per phase], "backward": [...]} (N s survived).
-    ``after_s``, ``form``: another push window and feedback form (the gain's choice)."""
+    ``after_s``, ``form``: another push window and feedback form (the gain's choice);
+    ``push_s``: how long each push's force is held (s)."""
     sp = stride_phase(network, K, after_s, form)
     if sp is None:
         return {"stride": None, "phases": list(phases), "forward": [0.0] * len(phases),
                 "backward": [0.0] * len(phases),
                 "note": "the unperturbed gait falls or does not step: no envelope"}
-    out = {"stride": {"t0_s": sp.t0_s, "period_s": sp.period_s}, "phases": list(phases)}
+    out = {"stride": {"t0_s": sp.t0_s, "period_s": sp.period_s}, "phases": list(phases),
+           "push_s": float(push_s)}
     for name, sign in (("forward", 1.0), ("backward", -1.0)):
         row = []
         for ph in phases:
             best = 0.0
             for imp in ladder:
-                if not survives(network, K, sp.time_at(ph), sign * imp, form):
+                if not survives(network, K, sp.time_at(ph), sign * imp, form, push_s):
                     break
                 best = float(imp)
             row.append(best)
@@ -120,18 +127,20 @@ def condition_survival(network: Network, gait: str | None, K: float) -> dict:
             "total": len(rows)}
 
 
-def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float | None = None
-               ) -> dict:
-    """The envelope and the condition survival for each feedback gain in ``gains``."""
+def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float | None = None,
+               push_s: float = PUSH_S) -> dict:
+    """The envelope and the condition survival for each feedback gain in ``gains``; each push's
+    force held for ``push_s`` seconds."""
     if mass_kg is None:
         from cpgbiped.envs.simulation.biped import body_constants
 
         mass_kg = body_constants()[1]
     res = {"network": network.kind, "preset": network.preset, "gait": gait,
-           "mass_kg": mass_kg, "hold_s": HOLD_S, "ladder_ns": list(IMPULSE_LADDER_NS),
+           "mass_kg": mass_kg, "hold_s": HOLD_S, "push_s": float(push_s),
+           "ladder_ns": list(IMPULSE_LADDER_NS),
            "by_gain": []}
     for K in gains:
-        env = push_envelope(network, K)
+        env = push_envelope(network, K, push_s=push_s)
         for name in ("forward", "backward"):
             env[f"{name}_min_ns"] = float(min(env[name]))
             env[f"{name}_min_ns_per_kg"] = float(min(env[name])) / mass_kg

@@ -78,19 +78,39 @@ def check_seconds(seconds: float, name: str = "seconds", limit: float = MAX_SECO
     return float(seconds)
 
 
+PUSH_TICK_S = 0.004  # one control tick (2 physics steps of 2 ms): the default push, a blow
+MAX_PUSH_S = 1.0  # longest push (s)
+
+
 def check_push(push, seconds: float):
-    """(time s, impulse N s) inside the rollout, or None."""
+    """(time s, impulse N s) or (time s, impulse N s, duration s) inside the rollout, or None;
+    returns (time, impulse, duration), the duration one control tick when not given."""
     if push is None:
         return None
-    t, imp = (float(x) for x in push)
+    if len(push) not in (2, 3):
+        raise InputError(f"a push is (time s, impulse N s[, duration s]), got {push!r}")
+    t, imp = float(push[0]), float(push[1])
+    dur = PUSH_TICK_S if len(push) == 2 else float(push[2])
     if not (np.isfinite(t) and np.isfinite(imp)):
         raise InputError(f"--push needs finite numbers, got {t} {imp}")
+    if not (np.isfinite(dur) and PUSH_TICK_S <= dur + 1e-12 and dur <= MAX_PUSH_S):
+        raise InputError(f"a push lasts from one control tick ({PUSH_TICK_S:g} s) to "
+                         f"{MAX_PUSH_S:g} s, got {dur:g} s")
     if not 0 <= t < seconds:
         raise InputError(f"--push time {t:g} s lies outside the rollout [0, {seconds:g}) s "
                          f"(simulation time from the start, settling included)")
     if not abs(imp) < 1e4:
         raise InputError(f"--push impulse must be below 1e4 N s in size, got {imp:g}")
-    return (t, imp)
+    return (t, imp, dur)
+
+
+def push_ticks(push, tick_s: float) -> tuple[int, int, float]:
+    """(first tick, number of ticks, force N) of a checked push: the force held over whole
+    control ticks, so that force x ticks x tick_s is the impulse; (-1, 0, 0) for none."""
+    if push is None:
+        return -1, 0, 0.0
+    n = max(1, int(round(push[2] / tick_s)))
+    return int(round(push[0] / tick_s)), n, push[1] / (n * tick_s)
 
 
 def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *,
@@ -103,7 +123,9 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
 
     Every tick records the joint positions and every body's world pose (forward kinematics of
     those positions). stop_on_fall=False keeps going after a fall (videos show it).
-    push: (time s, impulse N s) horizontal impulse on the torso. ankle_drive=False removes the
+    push: (time s, impulse N s[, duration s]) horizontal impulse on the torso, a constant force
+    held for the duration (default one control tick, 4 ms: a blow; SCONE's perturbation
+    tutorial holds 100 N for 0.2 s), rounded to whole control ticks. ankle_drive=False removes the
     CPG's ankle drive (the reflexes stay). to, change: the network's parameters move towards
     ``to``'s along ``change`` (knot times in seconds). poses=False skips the joint positions
     and body poses (``qpos``, ``body_pose`` stay empty): searches that only need the metrics
@@ -144,7 +166,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     afrc, avel = d.actuator_force, d.actuator_velocity
     ix, v, a, S = ctrl.ix, ctrl.last_v, ctrl.last_a, ctrl.S
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
-    push_tick = None if push is None else int(round(push[0] / (dt * CONTROL_EVERY)))
+    push_tick, push_n, push_force = push_ticks(push, dt * CONTROL_EVERY)
     P, qvel = ctrl.P, d.qvel
     if K > 0:
         L = ctrl.loop
@@ -162,8 +184,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
             return kernel.tick(k, d.time, sv, sa, sdt, P, S, qpos, qvel, sens, xpos, act,
                                ctrl_in, afrc, avel, ix, v, a, rec, FALL_HEIGHT, FALL_PITCH)
     if not poses:  # the whole loop compiled (envs.step_loop): the same rows, bit for bit
-        n, fell, unstable = _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec,
-                                           stop_on_fall)
+        n, fell, unstable = _compiled_loop(m, d, ctrl, n_ticks, push_tick, push_n, push_force,
+                                           torso_id, rec, stop_on_fall)
         return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path, K)
     try:
         # Tick k records row k - 1 (the state after the last steps) and sets the controls of
@@ -186,10 +208,11 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
                         break
             if k == n_ticks:
                 break
-            if k == push_tick:  # impulse = force x duration
-                d.xfrc_applied[torso_id, 0] = push[1] / (dt * CONTROL_EVERY)
+            pushing = 0 <= k - push_tick < push_n  # impulse = force x duration
+            if pushing:
+                d.xfrc_applied[torso_id, 0] = push_force
             mujoco.mj_step(m, d, nstep=CONTROL_EVERY)
-            if k == push_tick:
+            if pushing:
                 d.xfrc_applied[torso_id, 0] = 0.0
     except mujoco.FatalError as e:
         raise InputError(f"physics became unstable: {e}") from None
@@ -199,16 +222,15 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
 COMPILED_CHUNK = 250  # ticks (1 s) between two looks at MuJoCo's warnings
 
 
-def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push, torso_id, rec, stop_on_fall):
+def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push_n, force, torso_id, rec, stop_on_fall):
     """The tick loop of :func:`rollout` in compiled chunks; (rows, fell_at, unstable)."""
     from cpgbiped.envs.simulation.step_loop import run_ticks, run_ticks_closed
 
     dt = m.opt.timestep
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
-    force = 0.0 if push is None else push[1] / (dt * CONTROL_EVERY)
     args = (d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl, d.actuator_force,
             d.actuator_velocity, ctrl.ix, ctrl.last_v, ctrl.last_a, rec, FALL_HEIGHT,
-            FALL_PITCH, -1 if push_tick is None else push_tick, force, d.xfrc_applied, torso_id)
+            FALL_PITCH, push_tick, push_n, force, d.xfrc_applied, torso_id)
     k, n, fell = 0, 0, None
     sched = ctrl.sched
     while k <= n_ticks:

@@ -39,15 +39,17 @@ _mj_step = _library()
 
 
 @njit(inline="always")
-def _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, xfrc, torso_id):
-    """Tick k's physics steps, with the push's force during them when k is the push's tick;
-    returns MjData.time advanced by ``dt_s`` per step."""
-    if k == push_tick:
+def _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_n, push_force, xfrc,
+           torso_id):
+    """Tick k's physics steps, with the push's force during them when k is one of the push's
+    ``push_n`` ticks from ``push_tick``; returns MjData.time advanced by ``dt_s`` per step."""
+    pushing = push_tick >= 0 and 0 <= k - push_tick < push_n
+    if pushing:
         xfrc[torso_id, 0] = push_force
     for _ in range(control_every):
         _mj_step(m_addr, d_addr)
         t_s += dt_s
-    if k == push_tick:
+    if pushing:
         xfrc[torso_id, 0] = 0.0
     return t_s
 
@@ -55,7 +57,7 @@ def _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, x
 @njit
 def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, sa, sdt, P, S, qpos,
               qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec, fall_height, fall_pitch,
-              push_tick, push_force, xfrc, torso_id):
+              push_tick, push_n, push_force, xfrc, torso_id):
     """Ticks k0 .. k_end - 1 (each records row k - 1, sets tick k's controls and steps the
     physics; tick n_ticks only records). It returns after the tick whose row is fallen
     (status 1, its steps done) or non-finite (status 2, before its steps). ``t_s``: MjData.time at tick k0, advanced here by ``dt_s`` per physics step
@@ -68,8 +70,8 @@ def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, 
             return k + 1, status
         if k == n_ticks:
             return k + 1, status if k > 0 else 0
-        t_s = _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, xfrc,
-                     torso_id)
+        t_s = _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_n, push_force,
+                     xfrc, torso_id)
         if k > 0 and status == 1:  # row k - 1 fell; tick k's steps are done
             return k + 1, status
     return k_end, 0
@@ -79,7 +81,7 @@ def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, 
 def run_ticks_closed(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, code, NP,
                      P_ab, knots, y, K, n_sub, h, noise, act_c, act_w, weight_n, tick_s, sensors,
                      fb, scratch, P, S, qpos, qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a,
-                     rec, fall_height, fall_pitch, push_tick, push_force, xfrc, torso_id):
+                     rec, fall_height, fall_pitch, push_tick, push_n, push_force, xfrc, torso_id):
     """:func:`run_ticks` with the CPG stepped in the loop
     (:func:`cpgbiped.envs.control.control_kernel.tick_closed`)."""
     for k in range(k0, k_end):
@@ -91,8 +93,8 @@ def run_ticks_closed(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_
             return k + 1, status
         if k == n_ticks:
             return k + 1, status if k > 0 else 0
-        t_s = _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_force, xfrc,
-                     torso_id)
+        t_s = _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_n, push_force,
+                     xfrc, torso_id)
         if k > 0 and status == 1:
             return k + 1, status
     return k_end, 0
