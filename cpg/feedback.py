@@ -32,10 +32,14 @@ at K = 0.01 between them):
     dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0.
   scripts/feedback_choice.py scores every form at K = 0.01-0.1 (the pulse 0.05-0.2) by the
   push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
-  after 5.5 s), keeping only gains at which no rollout falls, the CPG classifier still names
-  the gait, and each preset
+  after 5.5 s, each held 0.2 s as SCONE's tutorial holds them), keeping only gains at which
+  no rollout falls, the CPG classifier still names the gait, and each preset
   passes its gait's criteria in as many seeds as open loop. On today's gains "angle" at
-  K = 0.01 scores 145 N s (open loop 145, both passing the criteria in 8 of 8 rollouts) and
+  K = 0.01 scores 177.5 N s (open loop 167.5; "load_antagonist" 155, "load" 152.5; at 0.03
+  and 0.05 "angle" scores 177.5 and 297.5 but the run's Froude number sinks below 0.25:
+  inadmissible). Scored with one-tick blows of the same impulses (the form until
+  2026-12-04) the choice was the same: "angle" at
+  K = 0.01 scored 145 N s (open loop 145, both passing the criteria in 8 of 8 rollouts) and
   "load_antagonist" at K = 0.01 140 (8 of 8); at K = 0.03 "load_antagonist" 162.5 and
   "angle" 200 but passing in 0 and 4 of 8 (inadmissible). Between the walk's push stages and
   its stance knee "load_antagonist" at K = 0.01 scored 125 (open loop 125) and "angle" at

@@ -49,13 +49,13 @@ PRESETS = {"ml": ("walk", "run"), "hopf": ("walk", "run"), "matsuoka": ("walk",)
 # Morris-Lecar candidates there, so the choice is made over four (README "Feedback").
 CHOICE_SEEDS = "1000,1001,1002,1003"
 CHOICE_PUSH_AFTER_S = 5.5
+PUSH_S = 0.2  # s: each push's force held as the product's pushes are (robustness.PUSH_S)
 
 
 def evaluate(job):
-    kind, preset, form, K, seed = job
+    kind, preset, form, K, seed, push_s = job
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.experiments.robustness import push_envelope
-    from cpgbiped.envs.simulation.rollout import PUSH_TICK_S
     from cpgbiped.envs.gaits.criteria import SETTLE_S
     from cpgbiped.envs.gaits.validate import measure_recording
     from cpgbiped.envs.simulation.rollout import rollout
@@ -64,8 +64,7 @@ def evaluate(job):
     ml_form = form if kind == "ml" else None
     rec = rollout(net, 22.0, poses=False, feedback=K, feedback_form=ml_form)
     s = measure_recording(net, preset, rec, SETTLE_S).summary()  # CPG gait and criteria
-    env = push_envelope(net, K, after_s=CHOICE_PUSH_AFTER_S, form=ml_form,
-                        push_s=PUSH_TICK_S)  # the blow its result file was scored with
+    env = push_envelope(net, K, after_s=CHOICE_PUSH_AFTER_S, form=ml_form, push_s=push_s)
     return {"network": kind, "preset": preset, "form": form, "gain": K, "cpg_seed": seed,
             "fell": rec.fell_at is not None, "cpg_gait": s["cpg_gait"],
             "criteria_passed": bool(s["passed"]),
@@ -85,6 +84,10 @@ def main(argv=None) -> int:
                     help="tuning-condition CPG seeds, comma separated (scores summed over them)")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "cpg"
                                          / "feedback_gains.json"))
+    ap.add_argument("--push-s", type=float, default=PUSH_S,
+                    help="how long each push's force is held, s (default 0.2, as SCONE's "
+                         "perturbed-gait tutorial and `cpgbiped robustness`; 0.004: one "
+                         "control tick, a blow, the form of every choice before 2026-12-04)")
     a = ap.parse_args(argv)
     seeds = [int(x) for x in a.seeds.split(",")]
     jobs = []
@@ -92,15 +95,16 @@ def main(argv=None) -> int:
         for form, K in [(cands[0][0], 0.0)] + cands:
             for preset in PRESETS[kind]:
                 for seed in seeds:
-                    jobs.append((kind, preset, form, K, seed))
+                    jobs.append((kind, preset, form, K, seed, a.push_s))
     t0 = time.time()
     with ProcessPoolExecutor(a.workers) as ex:
         rows = list(ex.map(evaluate, jobs))
     out = {"format": "cpgbiped.feedback_gains/1",
            "command": "python3 scripts/feedback_choice.py"
-                      + (f" --seeds {a.seeds}" if a.seeds != CHOICE_SEEDS else ""),
+                      + (f" --seeds {a.seeds}" if a.seeds != CHOICE_SEEDS else "")
+                      + (f" --push-s {a.push_s:g}" if a.push_s != PUSH_S else ""),
            "conditions": f"CPG seeds {a.seeds}, pushes in the stride after "
-                         f"{CHOICE_PUSH_AFTER_S} s (tuning conditions)",
+                         f"{CHOICE_PUSH_AFTER_S} s, each held {a.push_s:g} s (tuning conditions)",
            "networks": {}, "candidates": rows}
     for kind in CANDIDATES:
         by = {}
