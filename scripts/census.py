@@ -6,10 +6,11 @@ in [--first, --first + --n) and is validated for 20 s after settling, as ``cpgbi
 does, with the committed gains or --gains FILE:
 
     python scripts/census.py walk,run,jump,hop --first 3000 --n 30 [--gains FILE]
-                             [--friction F] [--push T I] [-v]
+                             [--friction F] [--push T I [--push-s S]] [-v]
 
 --friction scales the floor's friction, --push gives the torso a horizontal impulse of I N s
-at T s (simulation time, settling included), as ``validate`` does: the perturbations of the
+at T s (simulation time, settling included), its force held --push-s s (default 0.2, as
+``validate`` holds it): the perturbations of the
 tests measured over many states instead of one.
 
 Seeds 3000 and up are neither tuning conditions (1000-1099) nor the tests' (10-19).
@@ -44,13 +45,16 @@ def main() -> None:
     ap.add_argument("--friction", type=float, default=1.0, help="floor friction scale")
     ap.add_argument("--push", type=float, nargs=2, default=None, metavar=("T_S", "IMPULSE_NS"),
                     help="a horizontal push on the torso at T_S s of IMPULSE_NS N s (> 0 forwards)")
+    ap.add_argument("--push-s", type=float, default=0.2,
+                    help="how long the push's force is held, s (default 0.2, SCONE's; 0.004: "
+                         "one control tick, a blow)")
     ap.add_argument("--matrix", action="store_true",
                     help="also count the states from which every named preset gives its own "
                          "physical gait (the matrix's diagonal, `cpgbiped matrix --seed S`)")
     ap.add_argument("-v", action="store_true", help="one line per failing rollout")
     a = ap.parse_args()
     gaits = a.gaits.split(",")
-    push = tuple(a.push) if a.push else None
+    push = (*a.push, a.push_s) if a.push else None
     jobs = [(g, s, a.gains, a.friction, push) for g in gaits
             for s in range(a.first, a.first + a.n)]
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:

@@ -5,8 +5,9 @@ measured as tests/test_physics.py measures them (20 s after 2 s of settling), in
 
 Tables: the gait-quality metrics of each preset in the Table 3 state; each preset's criteria
 over the 13 test conditions (Table 3 state, CPG seeds 10-19, friction x0.7 and x1.3) with the
-failures by condition; the four perturbations (friction x0.5 and x2.0, a 5 N s push either way
-at 6 s); the ablation of the CPG's ankle drive. Writes OUT/report.md and OUT/summaries.json
+failures by condition; the six perturbations (friction x0.5 and x2.0, a 5 N s push either way
+at 6 s, held 0.2 s or struck in one 4 ms tick); the ablation of the CPG's ankle drive. Writes
+OUT/report.md and OUT/summaries.json
 (every rollout's summary) and prints the report.
 """
 from __future__ import annotations

@@ -172,7 +172,10 @@ TUNING_FEEDBACK = ("angle", 0.01)
 
 def tuning_conditions(n: int) -> list[dict]:
     """The first ``n`` tuning conditions: ``cpg_seed`` (a random initial CPG state), and for
-    most of them a floor friction scale or a push (time s, impulse N s) on the torso. From the
+    most of them a floor friction scale or a push (time s, impulse N s) on the torso, struck in
+    one 4 ms control tick (the rollout's default form; the pushes the product reports are held
+    0.2 s, :data:`cpgbiped.envs.experiments.robustness.PUSH_S`, a form no tuning condition
+    uses, so the committed chain of tuning runs replays bit for bit). From the
     ninth on, half of them drive the walk by another walk network (``weights``:
     {"walk": (w_a, w_b, w_c)}, :data:`TUNING_WALKS`) and half close the loop (``feedback``:
     the gain of :data:`TUNING_FEEDBACK`, through its pathway), so that the
