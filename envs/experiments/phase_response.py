@@ -1,7 +1,9 @@
 """Phase response of the coupled CPG and body to a push, against the phase of the push.
 
-For one network and one feedback gain K: a horizontal push of ``impulse`` N s on the torso at
-each phase of the stride (phase 0: a left touchdown of the unperturbed rollout after
+For one network and one feedback gain K: a horizontal push of ``impulse`` N s on the torso,
+struck in one 4 ms control tick (``rollout.PUSH_TICK_S``: a phase response curve probes with a
+brief perturbation, so that the phase it hits is one phase; the envelope's pushes are held
+0.2 s), at each phase of the stride (phase 0: a left touchdown of the unperturbed rollout after
 ``envs.robustness.PUSH_AFTER_S``; :func:`cpgbiped.envs.experiments.robustness.stride_phase`), and the unperturbed
 rollout beside it (the body may fall: the rollouts go on, the network keeps running).
 
@@ -24,7 +26,7 @@ from cpgbiped.cpg.network import Network
 
 from cpgbiped.envs.gaits.gait_metrics import debounce, edges
 from cpgbiped.envs.experiments.robustness import stride_phase
-from cpgbiped.envs.simulation.rollout import rollout
+from cpgbiped.envs.simulation.rollout import PUSH_TICK_S, rollout
 
 PHASES = tuple(np.round(np.arange(10) / 10, 2))
 IMPULSE_NS = 5.0
@@ -71,7 +73,8 @@ def phase_response(network: Network, K: float, phases=PHASES, impulse: float = I
     dphi, relock, fell = [], [], []
     for ph in phases:
         tp = sp.time_at(float(ph))
-        rec = rollout(network, tp + WINDOW_CYCLES * T_cpg_s, push=(tp, impulse), poses=False,
+        rec = rollout(network, tp + WINDOW_CYCLES * T_cpg_s, push=(tp, impulse, PUSH_TICK_S),
+                      poses=False,
                       feedback=K, stop_on_fall=False)
         fell.append(rec.fell_at is not None)
         on = onsets(rec.t, rec.drive[:, 2])
