@@ -84,12 +84,14 @@ def check_gait(gait: str | None) -> str | None:
 
 
 def validate(network: Network, gait: str | None = None, seconds: float = 20.0, *,
-             friction_scale: float = 1.0, push: tuple[float, float] | None = None,
+             friction_scale: float = 1.0, push: tuple[float, ...] | None = None,
              settle_s: float = SETTLE_S, stop_on_fall: bool = True, ankle_drive: bool = True,
              params: ControlParams = CONTROL, to: Network | None = None,
              change: Schedule | None = None, feedback: float = 0.0) -> Validation:
     """Roll out ``settle_s + seconds`` and measure the gait over the last ``seconds``;
-    ``feedback``: the gain K of the body's feedback into the CPG (0: open loop)."""
+    ``feedback``: the gain K of the body's feedback into the CPG (0: open loop); ``push``:
+    (time s, impulse N s[, held s]) as :func:`rollout` takes it (held one control tick when
+    no duration is given; ``cpgbiped validate --push`` holds it 0.2 s)."""
     check_gait(gait)
     seconds = check_seconds(seconds)
     rec = rollout(network, seconds + settle_s, params, friction_scale=friction_scale, push=push,
