@@ -23,7 +23,7 @@ score is printed beside it: feedback is recommended only as "the best closed loo
 better than open loop unless the numbers say so). Writes cpg/feedback_gains.json (read by
 cpg.feedback) with every candidate's numbers and this command.
 
-    python3 scripts/feedback_choice.py [--seeds 1000,1001,1002,1003] [--workers 2]
+    python3 scripts/feedback_choice.py [--seeds 1000,1001,1002,1003] [--push-s 0.2] [--workers 2]
                                        [--out cpg/feedback_gains.json]     (about 4 minutes)
 """
 from __future__ import annotations

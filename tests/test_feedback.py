@@ -241,7 +241,7 @@ def test_the_jump_survives_the_test_conditions_with_feedback():
 _ENVELOPE_SHORTFALLS = {
     ("run", "forward", "push"): "5 N s open loop, 2.5 with feedback (0.12 N s/kg)",
     ("run", "backward", "push"): "2.5 N s open loop and with feedback (0.12 N s/kg): after 5 N s "
-                                 "backwards in mid-stance the landing brakes the run to 0.8 "
+                                 "backwards at a quarter of the stride the landing brakes the run to 0.8 "
                                  "m/s, three strides later it overshoots to 1.85 m/s and a "
                                  "quick, mistimed step fells it",
     ("walk", "forward", "blow"): "10 N s open loop and with feedback (0.48 N s/kg): the blow "

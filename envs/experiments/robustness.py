@@ -7,8 +7,9 @@ loop), every number from the body, none from the network alone:
   backwards (-): a constant force held for ``PUSH_S`` = 0.2 s, as in SCONE's perturbed-gait
   tutorial (Tutorial 4c: 100 N for 0.2 s on the pelvis, 20 N s on its 75 kg model; the
   issue's "about 0.27 N s/kg"). ``push_s`` sets another duration, down to one control tick
-  (4 ms, ``rollout.PUSH_TICK_S``: a blow of the same impulse, the form the controller's
-  tuning conditions and ``scripts/feedback_choice.py`` use). The stride's phase comes from the unperturbed rollout
+  (4 ms, ``rollout.PUSH_TICK_S``: a blow of the same impulse, the form of the controller's
+  tuning conditions and of every envelope measured before 2026-12-04;
+  ``scripts/feedback_choice.py`` scores with the held pushes since then). The stride's phase comes from the unperturbed rollout
   with the same K: phase 0 is the first left touchdown at or after ``PUSH_AFTER_S`` (simulation
   time, settling included), the stride period the median of its left touchdown intervals. The
   impulse climbs ``IMPULSE_LADDER_NS`` until the body falls within ``HOLD_S`` of the push's start;

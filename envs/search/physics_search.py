@@ -103,7 +103,9 @@ def check_gait(gait: str) -> str:
 
 def perturbations(gait: str, settings: PhysicsSettings, seed: int) -> list[dict]:
     """The perturbation conditions of a run, drawn from ``seed``: dicts of ``cpg_seed``,
-    ``friction_scale`` and ``push`` (time s, impulse N s)."""
+    ``friction_scale`` and ``push`` (time s, impulse N s), struck in one control tick (the
+    rollout's default form; the envelope and the command line hold a push 0.2 s), so that the
+    committed results of ``optimize --physics`` replay."""
     rng = np.random.default_rng([int(seed), 14])
     out = []
     for _ in range(int(settings.n_trials)):

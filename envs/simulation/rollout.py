@@ -84,16 +84,17 @@ MAX_PUSH_S = 1.0  # longest push (s)
 
 def check_push(push, seconds: float):
     """(time s, impulse N s) or (time s, impulse N s, duration s) inside the rollout, or None;
-    returns (time, impulse, duration), the duration one control tick when not given."""
+    returns (time, impulse, duration), the duration None when not given (one control tick)."""
     if push is None:
         return None
     if len(push) not in (2, 3):
         raise InputError(f"a push is (time s, impulse N s[, duration s]), got {push!r}")
     t, imp = float(push[0]), float(push[1])
-    dur = PUSH_TICK_S if len(push) == 2 else float(push[2])
+    dur = None if len(push) == 2 else float(push[2])
     if not (np.isfinite(t) and np.isfinite(imp)):
         raise InputError(f"--push needs finite numbers, got {t} {imp}")
-    if not (np.isfinite(dur) and PUSH_TICK_S <= dur + 1e-12 and dur <= MAX_PUSH_S):
+    if dur is not None and not (np.isfinite(dur) and PUSH_TICK_S <= dur + 1e-12
+                                and dur <= MAX_PUSH_S):
         raise InputError(f"a push lasts from one control tick ({PUSH_TICK_S:g} s) to "
                          f"{MAX_PUSH_S:g} s, got {dur:g} s")
     if not 0 <= t < seconds:
@@ -109,12 +110,12 @@ def push_ticks(push, tick_s: float) -> tuple[int, int, float]:
     control ticks, so that force x ticks x tick_s is the impulse; (-1, 0, 0) for none."""
     if push is None:
         return -1, 0, 0.0
-    n = max(1, int(round(push[2] / tick_s)))
+    n = 1 if push[2] is None else max(1, int(round(push[2] / tick_s)))
     return int(round(push[0] / tick_s)), n, push[1] / (n * tick_s)
 
 
 def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *,
-            friction_scale: float = 1.0, push: tuple[float, float] | None = None,
+            friction_scale: float = 1.0, push: tuple[float, ...] | None = None,
             stop_on_fall: bool = True, ankle_drive: bool = True,
             to: Network | None = None, change: Schedule | None = None,
             xml_path: str | Path = BIPED_SCENE, poses: bool = True,

@@ -32,7 +32,8 @@ from cpgbiped.envs.gaits.criteria import SETTLE_S
 @dataclass(frozen=True)
 class Trial:
     """One rollout to score. ``preset``: the gait whose Table 3 state starts the network (and
-    whose parameters fill any left as None); ``push``: (time s, impulse N s) or None."""
+    whose parameters fill any left as None); ``push``: (time s, impulse N s[, held s]) or
+    None (as :func:`rollout` takes it: one control tick when no duration is given)."""
 
     preset: str
     weights: tuple[float, float, float]
@@ -40,7 +41,7 @@ class Trial:
     phi: float
     cpg_seed: int | None = None
     friction_scale: float = 1.0
-    push: tuple[float, float] | None = None
+    push: tuple[float, ...] | None = None
     feedback: float = 0.0  # gain K of the body's feedback into the CPG (cpg.feedback)
 
 
@@ -126,7 +127,7 @@ class ControlTrial:
     ``preset`` with its parameters, started from its Table 3 state or from a random one drawn
     from ``cpg_seed``, driving the body through the controller whose parameter array
     (:func:`cpgbiped.envs.control.controller.params_array`) is ``control``, under a condition (friction
-    scale, a push (time s, impulse N s)); ``weights`` (w_a, w_b, w_c) replace the preset's
+    scale, a push (time s, impulse N s[, held s])); ``weights`` (w_a, w_b, w_c) replace the preset's
     coupling weights (another network of the preset's family), ``feedback`` is the gain K of
     the body's feedback into the CPG (0: open loop) and ``feedback_form`` its Morris-Lecar
     pathway (None: the recommended one, ``cpg.feedback.CHOICE``); ``network`` the kind of
@@ -137,7 +138,7 @@ class ControlTrial:
     control: tuple
     cpg_seed: int | None = None
     friction_scale: float = 1.0
-    push: tuple[float, float] | None = None
+    push: tuple[float, ...] | None = None
     weights: tuple[float, float, float] | None = None
     feedback: float = 0.0
     network: str = "ml"
