@@ -51,6 +51,7 @@ def test_help_reads_like_a_manual():
     (["validate", "--push", "6", "5", "--push-s", "0.001"], "at least one control tick"),
     (["robustness", "--push-s", "nan"], "must be a number of seconds in [0.004, 1]"),
     (["log", "--rrd", "x.rrd", "--push", "6", "5", "--push-s", "2"], "[0.004, 1]"),
+    (["render", "--out", "x.mp4", "--seconds", "2", "--push", "6", "5"], "lies outside the rollout"),
 ])
 def test_bad_input_one_line_nonzero(args, msg):
     r = run(*args)

@@ -1053,6 +1053,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--fps", type=positive_arg, default=30.0)
     sp.add_argument("--fancy", action="store_true", help="shadows and reflections (slower)")
     sp.add_argument("--no-signals", action="store_true", help="no CPG strip under the video")
+    push_args(sp)
     sp.add_argument("--out", required=True, metavar="FILE.mp4")
     sp.set_defaults(seconds=8.0)
 
