@@ -628,8 +628,12 @@ def _validation(a, stop_on_fall=True, settle_s=None):
     net, label = _network(a)
     net.period()  # a network without a rhythm cannot drive the body: one line, before any work
     K = feedback_gain(a, net.kind)
+    push, push_s = getattr(a, "push", None), getattr(a, "push_s", None)
+    if push is None and push_s is not None:
+        raise _input_error("--push-s needs --push T_S IMPULSE_NS (it sets how long that push "
+                           "is held)")
     v = validate(net, a.gait, a.seconds, friction_scale=a.friction_scale,
-                 push=None if getattr(a, "push", None) is None else (*a.push, a.push_s),
+                 push=None if push is None else (*push, PUSH_S if push_s is None else push_s),
                  stop_on_fall=stop_on_fall,
                  settle_s=SETTLE_S if settle_s is None else settle_s,
                  ankle_drive=not a.no_ankle_drive, feedback=K)
@@ -1005,7 +1009,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="horizontal impulse on the torso at time T_S s (simulation time "
                              "from the start, settling included) of IMPULSE_NS N s (negative: "
                              "backwards)")
-        sp.add_argument("--push-s", type=push_seconds_arg, default=PUSH_S, metavar="S",
+        sp.add_argument("--push-s", type=push_seconds_arg, default=None, metavar="S",
                         help=f"how long the push's force is held, s (default {PUSH_S:g}, as "
                              f"SCONE's perturbed-gait tutorial; {PUSH_TICK_S:g}: one control "
                              f"tick, a blow)")
