@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.cpg.io import atomic_path, to_json
+from cpgbiped.cpg.io import atomic_path, signals_held, to_json
 
 from cpgbiped.envs.gaits.gait_metrics import debounce, edges
 
@@ -213,7 +213,9 @@ def write_rrd(path: str | Path, rollouts: dict, videos: dict | None = None,
     if path.suffix != ".rrd":
         raise InputError(f"rerun recordings end in .rrd, got {str(path)!r}")
     with atomic_path(path, suffix=".rrd") as tmp:
-        rs = rr.RecordingStream("cpgbiped")
+        with signals_held():  # a stream interrupted inside its constructor has no native
+            # handle, and its finaliser then prints a traceback as the interpreter exits
+            rs = rr.RecordingStream("cpgbiped")
         rs.save(str(tmp))
         for name, (rec, metrics) in rollouts.items():
             log_rollout(rs, name, rec, metrics, (videos or {}).get(name))
