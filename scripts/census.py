@@ -37,6 +37,8 @@ def one(job):
 
 
 def main() -> None:
+    from cpgbiped.envs.experiments.robustness import PUSH_S  # the product's pushes
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("gaits", help="comma-separated presets")
     ap.add_argument("--first", type=int, default=3000)
@@ -45,7 +47,7 @@ def main() -> None:
     ap.add_argument("--friction", type=float, default=1.0, help="floor friction scale")
     ap.add_argument("--push", type=float, nargs=2, default=None, metavar=("T_S", "IMPULSE_NS"),
                     help="a horizontal push on the torso at T_S s of IMPULSE_NS N s (> 0 forwards)")
-    ap.add_argument("--push-s", type=float, default=0.2,
+    ap.add_argument("--push-s", type=float, default=PUSH_S,
                     help="how long the push's force is held, s (default 0.2, SCONE's; 0.004: "
                          "one control tick, a blow)")
     ap.add_argument("--matrix", action="store_true",

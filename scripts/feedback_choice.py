@@ -49,7 +49,6 @@ PRESETS = {"ml": ("walk", "run"), "hopf": ("walk", "run"), "matsuoka": ("walk",)
 # Morris-Lecar candidates there, so the choice is made over four (README "Feedback").
 CHOICE_SEEDS = "1000,1001,1002,1003"
 CHOICE_PUSH_AFTER_S = 5.5
-PUSH_S = 0.2  # s: each push's force held as the product's pushes are (robustness.PUSH_S)
 
 
 def evaluate(job):
@@ -78,6 +77,8 @@ def criteria_passes(rows, presets) -> dict:
 
 
 def main(argv=None) -> int:
+    from cpgbiped.envs.experiments.robustness import PUSH_S  # the product's pushes
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seeds", default=CHOICE_SEEDS,

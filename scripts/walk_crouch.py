@@ -11,8 +11,9 @@ and the feedback's crossed the line. A hand sweep of single gains on tuning CPG 
 1000-1015 (out/hs/sweep.py: the walk's gait before 8 s and its criteria over 20 s, open loop
 and with the recommended feedback) found two gains that moved both: knee_crouch (-0.6: the
 walk named before 8 s from 13 and 15 of 16 states, open loop and with feedback, against 12 and
-9) and theta0 (0.25: 14 and 14, but the walk slows from Fr 0.13 to 0.10). knee_crouch from -0.6 to -0.4 was then measured by the
-rule below (RULE), fixed before the push envelopes were measured.
+9) and theta0 (0.25: 14 and 14, but the walk slows from Fr 0.13 to 0.10). knee_crouch from
+-0.6 to -0.4 was then measured by the rule below (RULE), fixed before the push envelopes were
+measured.
 """
 import sys
 from pathlib import Path

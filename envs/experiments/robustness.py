@@ -191,7 +191,7 @@ def envelope_picture(res: dict, path) -> None:
     sec = ax.secondary_yaxis("right", functions=(lambda x: x / m, lambda x: x * m))
     sec.set_ylabel("N s / kg")
     ax.set_title(f"{res['network']} {res['preset']}: push envelope (force held "
-                 f"{res.get('push_s', 0.004):g} s; fall within {res['hold_s']:g} s)", fontsize=10)
+                 f"{res['push_s']:g} s; fall within {res['hold_s']:g} s)", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
     with atomic_path(path) as tmp:

@@ -43,7 +43,7 @@ def _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_n, push_
            torso_id):
     """Tick k's physics steps, with the push's force during them when k is one of the push's
     ``push_n`` ticks from ``push_tick``; returns MjData.time advanced by ``dt_s`` per step."""
-    pushing = push_tick >= 0 and 0 <= k - push_tick < push_n
+    pushing = 0 <= k - push_tick < push_n  # never with no push (push_n 0)
     if pushing:
         xfrc[torso_id, 0] = push_force
     for _ in range(control_every):
