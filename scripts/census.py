@@ -21,6 +21,8 @@ import argparse
 import os
 from concurrent.futures import ProcessPoolExecutor
 
+SECONDS = 20.0  # validate's measured window (after its 2 s of settling)
+
 
 def one(job):
     """One preset from one random CPG state under one perturbation: (gait, seed, summary,
@@ -31,7 +33,7 @@ def one(job):
     from cpgbiped.envs.gaits.validate import validate
 
     params = read_gains(gains)[0] if gains else CONTROL
-    s = validate(build("ml", gait, seed=seed), gait, 20.0, params=params,
+    s = validate(build("ml", gait, seed=seed), gait, SECONDS, params=params,
                  friction_scale=friction, push=push).summary()
     return gait, seed, s, s["failures"]
 
@@ -57,6 +59,16 @@ def main() -> None:
     a = ap.parse_args()
     gaits = a.gaits.split(",")
     push = (*a.push, a.push_s) if a.push else None
+    if push is not None:  # the rollout's own check, before any worker starts
+        from cpgbiped.cpg.errors import InputError
+        from cpgbiped.envs.simulation.rollout import check_push
+
+        try:
+            from cpgbiped.envs.gaits.criteria import SETTLE_S
+
+            check_push(push, SETTLE_S + SECONDS)
+        except InputError as e:
+            ap.error(str(e))
     jobs = [(g, s, a.gains, a.friction, push) for g in gaits
             for s in range(a.first, a.first + a.n)]
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:

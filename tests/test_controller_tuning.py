@@ -13,6 +13,7 @@ from cpgbiped.cpg.cmaes import CMAES
 from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.optimize import RunSettings
 from cpgbiped.envs.gaits import gait_metrics as gm
+from cpgbiped.envs.control import control_kernel as kernel
 from cpgbiped.envs.control.controller import CONTROL, GAINS_FILE, read_gains
 from cpgbiped.envs.search.controller_tuning import (CORNER_OF, FIRST_TUNING_SEED, HORIZON,
                                     MAX_CONDITIONS, ROOT_GAINS_FILE, TuneSettings,
@@ -145,7 +146,7 @@ def test_settings_refuse_bad_input():
 
 
 def test_conditions_can_be_picked_by_number():
-    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-28,
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-32,
     reversed ranges and text are refused."""
     from cpgbiped.envs.search.controller_tuning import condition_ids
 
@@ -156,18 +157,54 @@ def test_conditions_can_be_picked_by_number():
     assert s.conditions() == every[:8] + every[20:24]
     assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
     assert condition_ids("3,3,1") == (3, 1)
-    for bad in ("0-3", "20-29", "5-2", "a", "1-", ""):
+    for bad in ("0-3", "20-33", "5-2", "a", "1-", ""):
         with pytest.raises(InputError):
             condition_ids(bad)
     with pytest.raises(InputError):
-        TuneSettings(("walk",), n_conditions=1, condition_ids=(29,))
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(33,))
     # 25-28: pushes twice the largest of the conditions before them, as many forwards as
     # backwards, each from a CPG state of its own
     big = [c["push"] for c in every[24:28]]
     before = max(abs(c["push"][1]) for c in every[:24] if "push" in c)
     assert all(abs(i) == 2 * before for _, i in big)
     assert sum(i > 0 for _, i in big) == sum(i < 0 for _, i in big) == 2
-    assert len({c["cpg_seed"] for c in every}) == len(every) == 28
+    # 29-32: a floor more slippery than any other condition's and than the tests' (x0.5)
+    slippery = [c["friction_scale"] for c in every[28:32]]
+    assert slippery == [0.4] * 4
+    assert all(c.get("friction_scale", 1.0) > 0.4 for c in every[:28])
+    from tests.test_physics import PERTURBATIONS
+    assert min(c["friction_scale"] for c in PERTURBATIONS if "friction_scale" in c) > 0.4
+    assert len({c["cpg_seed"] for c in every}) == len(every) == 32
+
+
+def test_the_start_up_gains_are_searched_when_named():
+    """--only startup.<corner>.*: the start-up corner's 24 gains (in the corner's box), whatever
+    --gait scores, and nothing else; set and read back through the gains file's "startup"
+    section without touching the corners; a gains file without start-up gains is refused."""
+    from dataclasses import replace
+
+    from cpgbiped.envs.control.controller import read_gains
+    from cpgbiped.envs.search.controller_tuning import values_of, with_values
+
+    s = TuneSettings(("walk", "run", "jump", "hop"), only=("startup.alternating_coactive.*",))
+    v = variables(s)
+    assert len(v) == 24 and all(n.startswith("startup.alternating_coactive.") for n, _, _ in v)
+    assert "startup.alternating_coactive.land_yield" not in [n for n, _, _ in v]
+    assert [n for n, _, _ in variables(TuneSettings(("walk",), only=(
+        "startup.synchronous.theta0", "push_off")))] == ["alternating.push_off",
+                                                         "startup.synchronous.theta0"]
+    with pytest.raises(InputError, match="unknown gain 'startup.foo.*'"):
+        TuneSettings(("walk",), only=("startup.foo.*",))
+    p = read_gains()[0]
+    names = [n for n, _, _ in v]
+    x = values_of(p, names)
+    assert x[names.index("startup.alternating_coactive.push")] == \
+        p.startup[list(kernel.CORNERS).index("alternating_coactive")].push
+    q = with_values(p, names, x + 0.01)
+    assert all(q.corner(c) == p.corner(c) for c in kernel.CORNERS) and q.startup != p.startup
+    assert np.allclose(values_of(q, names), x + 0.01)
+    with pytest.raises(InputError, match="start-up gains"):
+        values_of(replace(p, startup=None, startup_tau_s=0.0), names)
 
 
 def test_conditions_21_to_24_start_the_walk_network_in_a_jumps_rhythm():
@@ -402,7 +439,7 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 8
+    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 12
     control = tuple(params_array(CONTROL))
     hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
     ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)

@@ -1311,10 +1311,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=10.0,
                     help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
     sp.add_argument("--conditions", type=conditions_arg, default=(6, ()), metavar="N",
-                    help="tuning conditions per candidate: the first N (1-28, default 6), "
+                    help="tuning conditions per candidate: the first N (1-32, default 6), "
                          "or numbers and ranges such as 1-8,21-24 (21-24: CPG states "
                          "from which the walk network starts in a jump's rhythm; 25-28: "
-                         "pushes of 8 N s)")
+                         "pushes of 8 N s; 29-32: a floor of friction x0.4)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")
@@ -1325,7 +1325,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "(synchronous.theta0) or all of it (synchronous.*), so that "
                          "--gait walk,jump --only 'synchronous.*' searches the jump's corner "
                          "scored on both gaits; land_yield and lift_abort are searched only when "
-                         "named here")
+                         "named here; startup.<corner>.<gain> or startup.<corner>.* searches "
+                         "the start-up gains that hand over to the corners in the first "
+                         "seconds (every gait starts on them)")
     sp.add_argument("--start", default=None, metavar="GAINS.json",
                     help="gains file to start from (default: the controller's, envs/control/gains.json)")
     sp.add_argument("--guard", default="", metavar="GAITS",

@@ -123,7 +123,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 28
+MAX_CONDITIONS = 32
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 # CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
 # starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
@@ -137,6 +137,10 @@ TRANSIENT_SEEDS = (1030, 1037, 1038, 1075)
 # Conditions 25-28: pushes twice the size of the first eight's (8 N s), at two other moments,
 # both ways (issue 21's push envelope): CPG seeds 1040-1043, never a test's.
 BIG_PUSHES = ((1040, (6.3, 8.0)), (1041, (6.3, -8.0)), (1042, (6.8, 8.0)), (1043, (6.8, -8.0)))
+# Conditions 29-32: a slippery floor, friction x0.4 (below every other condition's and the tests'
+# x0.5: a start-up that survives it is paid for a margin, not for the tests' floor), from CPG
+# seeds 1052-1055, never a test's.
+SLIPPERY = tuple((1052 + k, 0.4) for k in range(4))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -185,7 +189,8 @@ def tuning_conditions(n: int) -> list[dict]:
     cycle, the Morris-Lecar walk's for 30%), so that the gains serve a rhythm rather than one
     network's waveform. The twenty-first to twenty-fourth start from :data:`TRANSIENT_SEEDS`
     (the walk network starts in a jump's rhythm), the twenty-fifth to twenty-eighth push the
-    torso by 8 N s (:data:`BIG_PUSHES`); pick them with :attr:`TuneSettings.condition_ids`
+    torso by 8 N s (:data:`BIG_PUSHES`), the twenty-ninth to thirty-second stand on a floor of
+    friction x0.4 (:data:`SLIPPERY`); pick them with :attr:`TuneSettings.condition_ids`
     (``--conditions 1-8,21-24``)."""
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
@@ -206,7 +211,8 @@ def tuning_conditions(n: int) -> list[dict]:
             **(extra[k] if k < len(extra) else variants[k - len(extra)])}
            for k in range(min(int(n), 20))]
     out += [{"cpg_seed": s} for s in TRANSIENT_SEEDS[:max(0, int(n) - 20)]]
-    return out + [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
+    out += [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
+    return out + [{"cpg_seed": s, "friction_scale": f} for s, f in SLIPPERY[:max(0, int(n) - 28)]]
 
 
 def condition_ids(text: str) -> tuple[int, ...]:
@@ -275,13 +281,15 @@ class TuneSettings:
 
     def __post_init__(self):
         known = (set(CORNER_RANGES) | set(SHARED_RANGES)
-                 | {f"{c}.{g}" for c in kernel.CORNERS for g in (*CORNER_RANGES, "*")})
+                 | {f"{pre}{c}.{g}" for pre in ("", STARTUP) for c in kernel.CORNERS
+                    for g in (*CORNER_RANGES, "*")})
         bad = [n for n in self.only if n not in known]
         if bad:
             raise InputError(f"unknown gain {', '.join(map(repr, bad))} in --only: use names "
                              f"of {', '.join(sorted(set(CORNER_RANGES) | set(SHARED_RANGES)))}, "
                              f"or <corner>.<gain> or <corner>.* with a corner of "
-                             f"{', '.join(kernel.CORNERS)}")
+                             f"{', '.join(kernel.CORNERS)}, or startup.<corner>.<gain> or "
+                             f"startup.<corner>.* (the start-up gains)")
         check_gaits(",".join(self.gaits))
         if self.guard:
             check_gaits(",".join(self.guard))
@@ -321,8 +329,18 @@ class TuneSettings:
         return ",".join(self.gaits)
 
 
+STARTUP = "startup."  # prefix of the start-up corners' gains (searched only when --only names them)
+
+
 def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
-    """(name, low, high) of every searched parameter: "<corner>.<gain>" or a shared name."""
+    """(name, low, high) of every searched parameter: "<corner>.<gain>", a shared name, or
+    "startup.<corner>.<gain>" (a start-up corner's gain, in the same box as the corner's: only
+    when ``only`` names it or its corner, ``startup.<corner>.*``, whatever --gait selects, since
+    every gait starts on the start-up corners' blend)."""
+    startup = [(f"{STARTUP}{c}.{k}", lo, hi) for c in kernel.CORNERS
+               for k, (lo, hi) in CORNER_RANGES.items()
+               if f"{STARTUP}{c}.{k}" in settings.only
+               or (f"{STARTUP}{c}.*" in settings.only and k not in OPT_IN)]
     out = []
     if settings.search in ("corners", "both"):
         for g in settings.gaits:
@@ -335,14 +353,17 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
                    and v[0].split(".")[-1] not in OPT_IN)]
     else:
         out = [v for v in out if v[0].split(".")[-1] not in OPT_IN]
-    return out
+    return out + startup
 
 
 def with_values(base: ControlParams, names: list[str], x) -> ControlParams:
     """``base`` with the named parameters set to ``x``."""
     d = params_to_dict(base)
     for n, v in zip(names, np.asarray(x, float)):
-        if "." in n:
+        if n.startswith(STARTUP):
+            c, g = n[len(STARTUP):].split(".")
+            d["startup"]["corners"][c][g] = float(v)
+        elif "." in n:
             c, g = n.split(".")
             d["corners"][c][g] = float(v)
         else:
@@ -354,8 +375,13 @@ def with_values(base: ControlParams, names: list[str], x) -> ControlParams:
 
 def values_of(p: ControlParams, names: list[str]) -> np.ndarray:
     d = params_to_dict(p)
-    return np.array([d["corners"][n.split(".")[0]][n.split(".")[1]] if "." in n
-                     else d["shared"][n] for n in names])
+    if any(n.startswith(STARTUP) for n in names) and "startup" not in d:
+        raise InputError("the start-up gains are searched only from a gains file that has "
+                          "them (its \"startup\" section; cpgbiped.envs.search."
+                          "controller_tuning.set_startup writes one)")
+    return np.array([d["startup"]["corners"][n[len(STARTUP):].split(".")[0]][n.split(".")[-1]]
+                     if n.startswith(STARTUP) else d["corners"][n.split(".")[0]][n.split(".")[1]]
+                     if "." in n else d["shared"][n] for n in names])
 
 
 def target_speed(gait: str) -> float | None:
