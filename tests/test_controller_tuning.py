@@ -110,7 +110,7 @@ def test_settings_refuse_bad_input():
     with pytest.raises(InputError, match="unknown gait"):
         check_gaits("walk,skip")
     for bad in (dict(algorithm="de"), dict(seconds=1.0), dict(n_conditions=MAX_CONDITIONS + 1),
-                dict(sigma=0.0)):
+                dict(sigma=0.0), dict(worst_weight=-1.0), dict(worst_weight=float("nan"))):
         with pytest.raises(InputError):
             TuneSettings(("walk",), **bad)
     assert check_gaits("all") == tuple(CORNER_OF)
@@ -145,8 +145,21 @@ def test_settings_refuse_bad_input():
         TuneSettings(("walk",), only=("synchronous.*",))  # the walk's search has no such corner
 
 
+def test_the_worst_condition_weighs_as_told():
+    """CMA-ES's single objective and the final pick are mean + w x max over the conditions:
+    w = 0.5 by default (the committed chain's), 0 the mean alone."""
+    from cpgbiped.envs.search.controller_tuning import ControllerTuningProblem
+
+    costs = np.array([[1.0, 2.0, 9.0], [4.0, 4.0, 4.0]])  # per point, per condition
+    default = ControllerTuningProblem(TuneSettings(("walk",)), CONTROL)
+    mean_only = ControllerTuningProblem(TuneSettings(("walk",), worst_weight=0.0), CONTROL)
+    assert default.score(costs).tolist() == [4.0 + 4.5, 4.0 + 2.0]  # the even one wins
+    assert mean_only.score(costs).tolist() == [4.0, 4.0]
+    assert default.objectives(costs)[:, 0].tolist() == default.score(costs).tolist()
+
+
 def test_conditions_can_be_picked_by_number():
-    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-32,
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-36,
     reversed ranges and text are refused."""
     from cpgbiped.envs.search.controller_tuning import condition_ids
 
@@ -157,24 +170,25 @@ def test_conditions_can_be_picked_by_number():
     assert s.conditions() == every[:8] + every[20:24]
     assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
     assert condition_ids("3,3,1") == (3, 1)
-    for bad in ("0-3", "20-33", "5-2", "a", "1-", ""):
+    for bad in ("0-3", "20-37", "5-2", "a", "1-", ""):
         with pytest.raises(InputError):
             condition_ids(bad)
     with pytest.raises(InputError):
-        TuneSettings(("walk",), n_conditions=1, condition_ids=(33,))
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(37,))
     # 25-28: pushes twice the largest of the conditions before them, as many forwards as
     # backwards, each from a CPG state of its own
     big = [c["push"] for c in every[24:28]]
     before = max(abs(c["push"][1]) for c in every[:24] if "push" in c)
     assert all(abs(i) == 2 * before for _, i in big)
     assert sum(i > 0 for _, i in big) == sum(i < 0 for _, i in big) == 2
-    # 29-32: a floor more slippery than any other condition's and than the tests' (x0.5)
-    slippery = [c["friction_scale"] for c in every[28:32]]
-    assert slippery == [0.4] * 4
+    # 29-32: a floor more slippery than any other condition's and than the tests' (x0.5); 33-36
+    # the sixth condition's x0.6 from four more states
+    slippery = [c["friction_scale"] for c in every[28:36]]
+    assert slippery == [0.4] * 4 + [0.6] * 4
     assert all(c.get("friction_scale", 1.0) > 0.4 for c in every[:28])
     from tests.test_physics import PERTURBATIONS
     assert min(c["friction_scale"] for c in PERTURBATIONS if "friction_scale" in c) > 0.4
-    assert len({c["cpg_seed"] for c in every}) == len(every) == 32
+    assert len({c["cpg_seed"] for c in every}) == len(every) == 36
 
 
 def test_the_start_up_gains_are_searched_when_named():
@@ -439,7 +453,7 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 12
+    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 16
     control = tuple(params_array(CONTROL))
     hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
     ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)

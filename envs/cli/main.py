@@ -418,7 +418,7 @@ def only_arg(text: str) -> tuple[str, ...]:
 def cmd_tune(a) -> int:
     from cpgbiped.cpg.optimize import RunSettings
     from cpgbiped.envs.control.controller import GAINS_FILE
-    from cpgbiped.envs.search.controller_tuning import (HORIZON, SHORTFALL, TuneSettings,
+    from cpgbiped.envs.search.controller_tuning import (HORIZON, SHORTFALL, WORST, TuneSettings,
                                                           check_gaits, tune, variables)
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
@@ -428,7 +428,8 @@ def cmd_tune(a) -> int:
     guard = check_gaits(a.guard) if a.guard else ()
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
                             n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "",
-                            SHORTFALL if a.shortfall_weight is None else a.shortfall_weight)
+                            SHORTFALL if a.shortfall_weight is None else a.shortfall_weight,
+                            WORST if a.worst_weight is None else a.worst_weight)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1311,10 +1312,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=10.0,
                     help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
     sp.add_argument("--conditions", type=conditions_arg, default=(6, ()), metavar="N",
-                    help="tuning conditions per candidate: the first N (1-32, default 6), "
+                    help="tuning conditions per candidate: the first N (1-36, default 6), "
                          "or numbers and ranges such as 1-8,21-24 (21-24: CPG states "
                          "from which the walk network starts in a jump's rhythm; 25-28: "
-                         "pushes of 8 N s; 29-32: a floor of friction x0.4)")
+                         "pushes of 8 N s; 29-32: a floor of friction x0.4; 33-36: x0.6)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")
@@ -1340,6 +1341,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--shortfall-weight", type=finite_arg, default=None, metavar="W",
                     help="weight of the criteria's pattern and quality shortfalls in the cost "
                          "(default 3, against 10 for seconds upright and for progress; 0-100)")
+    sp.add_argument("--worst-weight", type=finite_arg, default=None, metavar="W",
+                    help="weight of the worst condition's cost beside the mean (CMA-ES "
+                         "minimises mean + W max, and the best point is picked so; default "
+                         "0.5; 0: the mean alone; 0-10)")
     sp.add_argument("--workers", type=count_arg(1), default=None,
                     help="rollout processes (default: one per core)")
     sp.add_argument("--dask", nargs="?", const="local", default=None, metavar="ADDRESS",

@@ -42,7 +42,8 @@ Progress is the distance until a fall, as in SCONE's gait measures: a candidate 
 far before it falls ranks above one that stands still, so a search that starts from
 standing is led towards walking instead of towards not moving.
 A candidate's cost sums its gaits' costs per condition; over the conditions, CMA-ES minimises
-mean + 0.5 max (the worst condition counts), NSGA-II the pair (mean, max).
+mean + w max (the worst condition counts; w = WORST = 0.5 unless ``--worst-weight`` sets it),
+NSGA-II the pair (mean, max), and the best point is the least mean + w max.
 The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
 there under the guard's gains (``--guard-gains``, default the start) by more than GUARD_TOL;
 each unit beyond adds GUARD to that condition. A search of the jump's corner scored on the
@@ -112,6 +113,7 @@ if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHAR
 
 TARGET_FROUDE = {"walk": 0.11, "run": 0.33}  # progress target (criteria: Fr >= 0.08, 0.25)
 SURVIVAL, PROGRESS, FALL, SHORTFALL, MARGIN = 10.0, 10.0, 5.0, 3.0, 0.03
+WORST = 0.5  # the worst condition's weight beside the mean (--worst-weight)
 MAX_SHORTFALL_WEIGHT = 100.0  # --shortfall-weight's bound (a sanity bound, not a tuned value)
 POSTURE, LEAN_FREE_DEG = 1.0, 10.0  # per 10 deg of mean trunk lean beyond 10 deg
 # The guard (--guard): a guarded gait's cost in a condition may exceed its cost under the
@@ -123,7 +125,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 32
+MAX_CONDITIONS = 36
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 # CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
 # starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
@@ -137,10 +139,10 @@ TRANSIENT_SEEDS = (1030, 1037, 1038, 1075)
 # Conditions 25-28: pushes twice the size of the first eight's (8 N s), at two other moments,
 # both ways (issue 21's push envelope): CPG seeds 1040-1043, never a test's.
 BIG_PUSHES = ((1040, (6.3, 8.0)), (1041, (6.3, -8.0)), (1042, (6.8, 8.0)), (1043, (6.8, -8.0)))
-# Conditions 29-32: a slippery floor, friction x0.4 (below every other condition's and the tests'
-# x0.5: a start-up that survives it is paid for a margin, not for the tests' floor), from CPG
-# seeds 1052-1055, never a test's.
-SLIPPERY = tuple((1052 + k, 0.4) for k in range(4))
+# Conditions 29-36: a slippery floor, friction x0.4 (below every other condition's and the tests'
+# x0.5: a start-up that survives it is paid for a margin, not for the tests' floor), then x0.6
+# (the sixth condition's, from more states), from CPG seeds 1052-1059, never a test's.
+SLIPPERY = tuple((1052 + k, 0.4) for k in range(4)) + tuple((1056 + k, 0.6) for k in range(4))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -190,7 +192,7 @@ def tuning_conditions(n: int) -> list[dict]:
     network's waveform. The twenty-first to twenty-fourth start from :data:`TRANSIENT_SEEDS`
     (the walk network starts in a jump's rhythm), the twenty-fifth to twenty-eighth push the
     torso by 8 N s (:data:`BIG_PUSHES`), the twenty-ninth to thirty-second stand on a floor of
-    friction x0.4 (:data:`SLIPPERY`); pick them with :attr:`TuneSettings.condition_ids`
+    friction x0.4 and the thirty-third to thirty-sixth on x0.6 (:data:`SLIPPERY`); pick them with :attr:`TuneSettings.condition_ids`
     (``--conditions 1-8,21-24``)."""
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
@@ -271,6 +273,7 @@ class TuneSettings:
     guard: tuple[str, ...] = ()  # gaits that may not get worse than under guard_gains
     guard_gains: str = ""  # the gains file the guard compares with (empty: the start's)
     shortfall_weight: float = SHORTFALL  # weight of the pattern and quality shortfalls
+    worst_weight: float = WORST  # CMA-ES and the final pick minimise mean + worst_weight x max
 
     def conditions(self) -> list[dict]:
         """The tuning conditions every candidate is scored under."""
@@ -316,6 +319,8 @@ class TuneSettings:
                     f"{cond['push'][0] - SETTLE_S:g} or leave condition {k} out")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
+        if not (np.isfinite(self.worst_weight) and 0.0 <= self.worst_weight <= 10.0):
+            raise InputError(f"--worst-weight must be in [0, 10], got {self.worst_weight}")
         if not (np.isfinite(self.shortfall_weight)
                 and 0.0 <= self.shortfall_weight <= MAX_SHORTFALL_WEIGHT):
             raise InputError(f"--shortfall-weight must be in [0, {MAX_SHORTFALL_WEIGHT:g}], "
@@ -487,16 +492,19 @@ class ControllerTuningProblem(Problem):
             costs[k] = gc.sum(axis=1) + self.guard_penalty(gc)
         return costs, groups
 
+    def score(self, costs: np.ndarray) -> np.ndarray:
+        """mean + worst_weight x max over the conditions, per point."""
+        return costs.mean(axis=1) + self.settings.worst_weight * costs.max(axis=1)
+
     def objectives(self, costs: np.ndarray) -> np.ndarray:
-        mean, worst = costs.mean(axis=1), costs.max(axis=1)
         if self.n_obj == 1:
-            return (mean + 0.5 * worst)[:, None]
-        return np.stack([mean, worst], axis=1)
+            return self.score(costs)[:, None]
+        return np.stack([costs.mean(axis=1), costs.max(axis=1)], axis=1)
 
     def _evaluate(self, X, out, *args, **kwargs):
         costs, _ = self.evaluate_points(X)
         out["F"] = self.objectives(costs)
-        score = costs.mean(axis=1) + 0.5 * costs.max(axis=1)
+        score = self.score(costs)
         self.history.append((len(self.history) + 1, float(score.min()), float(np.median(score))))
 
     def resume_key(self) -> dict:
@@ -605,11 +613,11 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     res = run(problem, rs, checkpoint=ckpt, on_generation=on_generation, stop_after=stop_after,
               algorithm=algorithm)
     # The best point: CMA-ES's best evaluated; NSGA-II's non-dominated point of least
-    # mean + 0.5 max. Rolled out again (deterministic) for the record.
+    # mean + worst_weight x max. Rolled out again (deterministic) for the record.
     # The start itself is a candidate: a search that finds nothing better keeps it.
     P = np.vstack([np.atleast_2d(res.pareto_X), x0[None]])
     costs, summaries = problem.evaluate_points(P)
-    score = costs.mean(axis=1) + 0.5 * costs.max(axis=1)
+    score = problem.score(costs)
     k = int(np.argmin(score))
     best_x, start_score = P[k], float(score[-1])
     tuned = with_values(base, problem.names, best_x)
