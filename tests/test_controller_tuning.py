@@ -145,6 +145,27 @@ def test_settings_refuse_bad_input():
         TuneSettings(("walk",), only=("synchronous.*",))  # the walk's search has no such corner
 
 
+def test_survival_only_conditions_count_the_seconds_upright_alone():
+    """--survival-only: a named condition costs SURVIVAL x (1 - up / T) (+ FALL after a fall),
+    whatever the speed, the criteria or the posture; the others keep every term; a number
+    outside --conditions is refused."""
+    from cpgbiped.envs.search.controller_tuning import FALL, SURVIVAL
+
+    good = walk_summary()
+    slow = walk_summary(speed=0.1)
+    assert rollout_cost("walk", slow, 10.0) > rollout_cost("walk", good, 10.0) + 3.0
+    assert rollout_cost("walk", slow, 10.0, survival_only=True) == 0.0
+    assert rollout_cost("walk", good, 10.0, survival_only=True) == 0.0
+    fell = walk_summary(speed=0.1, fell_at=7.0, survived=7.0)  # 5 of 10 measured s upright
+    assert rollout_cost("walk", fell, 10.0, survival_only=True) == pytest.approx(
+        SURVIVAL * 0.5 + FALL)
+    s = TuneSettings(("run",), condition_ids=(1, 2, 29, 30), n_conditions=4,
+                     survival_only=(29, 30))
+    assert s.survival_mask().tolist() == [False, False, True, True]
+    with pytest.raises(InputError, match="survival-only 31"):
+        TuneSettings(("run",), condition_ids=(1, 29), n_conditions=2, survival_only=(31,))
+
+
 def test_the_worst_condition_weighs_as_told():
     """CMA-ES's single objective and the final pick are mean + w x max over the conditions:
     w = 0.5 by default (the committed chain's), 0 the mean alone."""

@@ -392,6 +392,17 @@ def cmd_optimize_physics(a) -> int:
     return 0
 
 
+def condition_ids_arg(text: str) -> tuple[int, ...]:
+    """Numbers and ranges of tuning conditions (29-36, 1,6)."""
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.envs.search.controller_tuning import condition_ids
+
+    try:
+        return condition_ids(text)
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
 def conditions_arg(text: str) -> tuple[int, tuple[int, ...]]:
     """``--conditions``: N (the first N tuning conditions) or numbers and ranges (1-8,21-24);
     returns (how many, their numbers or () for the first N)."""
@@ -429,7 +440,8 @@ def cmd_tune(a) -> int:
     settings = TuneSettings(check_gaits(a.gait), a.search, a.algorithm, a.seconds,
                             n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "",
                             SHORTFALL if a.shortfall_weight is None else a.shortfall_weight,
-                            WORST if a.worst_weight is None else a.worst_weight)
+                            WORST if a.worst_weight is None else a.worst_weight,
+                            a.survival_only)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1341,6 +1353,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--shortfall-weight", type=finite_arg, default=None, metavar="W",
                     help="weight of the criteria's pattern and quality shortfalls in the cost "
                          "(default 3, against 10 for seconds upright and for progress; 0-100)")
+    sp.add_argument("--survival-only", type=condition_ids_arg, default=(), metavar="IDS",
+                    help="conditions (numbers and ranges, among --conditions) scored on the "
+                         "seconds upright and the fall alone, not the speed or the criteria: "
+                         "a floor where staying up is all that is asked (e.g. 29-36)")
     sp.add_argument("--worst-weight", type=finite_arg, default=None, metavar="W",
                     help="weight of the worst condition's cost beside the mean (CMA-ES "
                          "minimises mean + W max, and the best point is picked so; default "

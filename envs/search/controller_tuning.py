@@ -43,6 +43,8 @@ far before it falls ranks above one that stands still, so a search that starts f
 standing is led towards walking instead of towards not moving.
 A candidate's cost sums its gaits' costs per condition; over the conditions, CMA-ES minimises
 mean + w max (the worst condition counts; w = WORST = 0.5 unless ``--worst-weight`` sets it),
+``--survival-only 29-36`` scores the named conditions on SURVIVAL and FALL alone (a slippery
+floor where staying up is all that is asked, not the speed or the criteria),
 NSGA-II the pair (mean, max), and the best point is the least mean + w max.
 The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
 there under the guard's gains (``--guard-gains``, default the start) by more than GUARD_TOL;
@@ -274,6 +276,15 @@ class TuneSettings:
     guard_gains: str = ""  # the gains file the guard compares with (empty: the start's)
     shortfall_weight: float = SHORTFALL  # weight of the pattern and quality shortfalls
     worst_weight: float = WORST  # CMA-ES and the final pick minimise mean + worst_weight x max
+    survival_only: tuple[int, ...] = ()  # 1-based conditions scored on seconds upright alone
+
+    def ids(self) -> tuple[int, ...]:
+        """The 1-based numbers of :meth:`conditions`, in order."""
+        return self.condition_ids or tuple(range(1, self.n_conditions + 1))
+
+    def survival_mask(self) -> np.ndarray:
+        """Per condition of :meth:`conditions`: scored on seconds upright alone."""
+        return np.array([k in self.survival_only for k in self.ids()], bool)
 
     def conditions(self) -> list[dict]:
         """The tuning conditions every candidate is scored under."""
@@ -310,6 +321,10 @@ class TuneSettings:
             raise InputError(f"seconds per rollout must be in [2, 60], got {self.seconds}")
         if any(not 1 <= k <= MAX_CONDITIONS for k in self.condition_ids):
             raise InputError(f"tuning conditions are numbered 1-{MAX_CONDITIONS}")
+        extra = [k for k in self.survival_only if k not in self.ids()]
+        if extra:
+            raise InputError(f"--survival-only {','.join(map(str, extra))}: not among the "
+                             f"conditions the search scores ({','.join(map(str, self.ids()))})")
         for k, cond in zip(self.condition_ids or range(1, self.n_conditions + 1),
                            self.conditions()):
             if "push" in cond and cond["push"][0] >= SETTLE_S + self.seconds:
@@ -397,11 +412,15 @@ def target_speed(gait: str) -> float | None:
 
 
 def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S,
-                 shortfall: float = SHORTFALL) -> float:
+                 shortfall: float = SHORTFALL, survival_only: bool = False) -> float:
     """The cost of one rollout summary (:func:`cpgbiped.envs.simulation.trials.run_control_trial`); see the module
-    docstring. ``shortfall``: the weight of the pattern and quality shortfalls."""
+    docstring. ``shortfall``: the weight of the pattern and quality shortfalls;
+    ``survival_only``: the seconds upright and the fall alone (a condition where staying up is
+    all that is asked, ``--survival-only``)."""
     up = float(np.clip(s["survived_s"] - settle_s, 0.0, seconds))
     c = SURVIVAL * (1.0 - up / seconds)
+    if survival_only:
+        return float(c + (FALL if s["fell"] else 0.0))
     v = target_speed(gait)
     if v is not None:
         d = float(s["distance_m"]) if np.isfinite(s["distance_m"]) else 0.0
@@ -448,8 +467,10 @@ class ControllerTuningProblem(Problem):
     def gait_costs(self, results: list) -> np.ndarray:
         """(n_conditions, n_gaits) rollout costs of one point's results (condition-major)."""
         n_g, n_c = len(self.settings.gaits), len(self.conditions)
+        only = self.settings.survival_mask()
         return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds,
-                                       shortfall=self.settings.shortfall_weight)
+                                       shortfall=self.settings.shortfall_weight,
+                                       survival_only=bool(only[c]))
                           for j, g in enumerate(self.settings.gaits)] for c in range(n_c)])
 
     def reference_costs(self) -> np.ndarray:
@@ -659,7 +680,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                          cond.get("push", ""), cond.get("weights", {}).get(g, ""),
                          cond.get("feedback", 0.0),
                          round(rollout_cost(g, s, settings.seconds,
-                                            shortfall=settings.shortfall_weight), 4),
+                                            shortfall=settings.shortfall_weight,
+                                            survival_only=bool(settings.survival_mask()[c])), 4),
                          s["fell"], s["physical_gait"], _r(s["speed_mps"]), _r(s["froude"]),
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
