@@ -164,6 +164,17 @@ def test_survival_only_conditions_count_the_seconds_upright_alone():
     assert s.survival_mask().tolist() == [False, False, True, True]
     with pytest.raises(InputError, match="survival-only 31"):
         TuneSettings(("run",), condition_ids=(1, 29), n_conditions=2, survival_only=(31,))
+    # the first N conditions: the numbers are 1..N
+    assert TuneSettings(("walk",), n_conditions=6, survival_only=(6,)).survival_mask().tolist() \
+        == [False] * 5 + [True]
+    # per condition: the same slow walk costs its shortfalls in condition 1, nothing in 29
+    from cpgbiped.envs.search.controller_tuning import ControllerTuningProblem
+
+    prob = ControllerTuningProblem(TuneSettings(("walk",), condition_ids=(1, 29), n_conditions=2,
+                                                survival_only=(29,)), CONTROL)
+    gc = prob.gait_costs([slow, slow])
+    assert gc[0, 0] == pytest.approx(rollout_cost("walk", slow, 10.0)) and gc[0, 0] > 3.0
+    assert gc[1, 0] == 0.0
 
 
 def test_the_worst_condition_weighs_as_told():

@@ -446,7 +446,11 @@ def cmd_tune(a) -> int:
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
 
-    read_gains(start)  # a bad starting file is refused before any work
+    from cpgbiped.envs.search.controller_tuning import values_of
+
+    # a bad starting file, or one without the start-up gains a search names, is refused
+    # before any work
+    values_of(read_gains(start)[0], [n for n, _, _ in variables(settings)])
     if a.guard_gains:
         read_gains(a.guard_gains)
     args = (settings.seconds, 2.0)

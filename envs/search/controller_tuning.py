@@ -7,8 +7,9 @@ synchronous and co-active; measured in tests/test_controller.py). A run scores t
 names (``--gait walk``, ``--gait jump,hop``, ``--gait all``) and searches (``--search``) their
 corners, in the box :data:`CORNER_RANGES`, or the shared parameters (:data:`SHARED_RANGES`:
 ankle gain, swing wiring, contact hold; the lift abort only when named), which every gait
-uses, or both; everything else stays
-as in the starting gains file. Shared parameters are best searched with every gait scored
+uses, or both; the start-up gains (the gains file's "startup" corners, which hand over to the
+corners in the first seconds) only when ``--only`` names them (``startup.<corner>.*``);
+everything else stays as in the starting gains file. Shared parameters are best searched with every gait scored
 (``--gait all --search shared``): a walk tuned alone once turned the crossed-extension swing
 drive down to 0.1, and the run, which swings on it, could no longer lift a leg.
 
@@ -43,9 +44,9 @@ far before it falls ranks above one that stands still, so a search that starts f
 standing is led towards walking instead of towards not moving.
 A candidate's cost sums its gaits' costs per condition; over the conditions, CMA-ES minimises
 mean + w max (the worst condition counts; w = WORST = 0.5 unless ``--worst-weight`` sets it),
-``--survival-only 29-36`` scores the named conditions on SURVIVAL and FALL alone (a slippery
-floor where staying up is all that is asked, not the speed or the criteria),
 NSGA-II the pair (mean, max), and the best point is the least mean + w max.
+``--survival-only 29-36`` scores the named conditions on SURVIVAL and FALL alone (a slippery
+floor where staying up is all that is asked, not the speed or the criteria).
 The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
 there under the guard's gains (``--guard-gains``, default the start) by more than GUARD_TOL;
 each unit beyond adds GUARD to that condition. A search of the jump's corner scored on the
@@ -116,6 +117,7 @@ if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHAR
 TARGET_FROUDE = {"walk": 0.11, "run": 0.33}  # progress target (criteria: Fr >= 0.08, 0.25)
 SURVIVAL, PROGRESS, FALL, SHORTFALL, MARGIN = 10.0, 10.0, 5.0, 3.0, 0.03
 WORST = 0.5  # the worst condition's weight beside the mean (--worst-weight)
+MAX_WORST_WEIGHT = 10.0  # --worst-weight's bound (a sanity bound, not a tuned value)
 MAX_SHORTFALL_WEIGHT = 100.0  # --shortfall-weight's bound (a sanity bound, not a tuned value)
 POSTURE, LEAN_FREE_DEG = 1.0, 10.0  # per 10 deg of mean trunk lean beyond 10 deg
 # The guard (--guard): a guarded gait's cost in a condition may exceed its cost under the
@@ -276,7 +278,7 @@ class TuneSettings:
     guard_gains: str = ""  # the gains file the guard compares with (empty: the start's)
     shortfall_weight: float = SHORTFALL  # weight of the pattern and quality shortfalls
     worst_weight: float = WORST  # CMA-ES and the final pick minimise mean + worst_weight x max
-    survival_only: tuple[int, ...] = ()  # 1-based conditions scored on seconds upright alone
+    survival_only: tuple[int, ...] = ()  # 1-based conditions scored on seconds upright and fall
 
     def ids(self) -> tuple[int, ...]:
         """The 1-based numbers of :meth:`conditions`, in order."""
@@ -334,8 +336,9 @@ class TuneSettings:
                     f"{cond['push'][0] - SETTLE_S:g} or leave condition {k} out")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
-        if not (np.isfinite(self.worst_weight) and 0.0 <= self.worst_weight <= 10.0):
-            raise InputError(f"--worst-weight must be in [0, 10], got {self.worst_weight}")
+        if not (np.isfinite(self.worst_weight) and 0.0 <= self.worst_weight <= MAX_WORST_WEIGHT):
+            raise InputError(f"--worst-weight must be in [0, {MAX_WORST_WEIGHT:g}], "
+                             f"got {self.worst_weight}")
         if not (np.isfinite(self.shortfall_weight)
                 and 0.0 <= self.shortfall_weight <= MAX_SHORTFALL_WEIGHT):
             raise InputError(f"--shortfall-weight must be in [0, {MAX_SHORTFALL_WEIGHT:g}], "
@@ -379,6 +382,7 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
 def with_values(base: ControlParams, names: list[str], x) -> ControlParams:
     """``base`` with the named parameters set to ``x``."""
     d = params_to_dict(base)
+    values_of(base, names)  # start-up names need a file with start-up gains
     for n, v in zip(names, np.asarray(x, float)):
         if n.startswith(STARTUP):
             c, g = n[len(STARTUP):].split(".")
