@@ -61,11 +61,10 @@ def main() -> None:
     push = (*a.push, a.push_s) if a.push else None
     if push is not None:  # the rollout's own check, before any worker starts
         from cpgbiped.cpg.errors import InputError
+        from cpgbiped.envs.gaits.criteria import SETTLE_S
         from cpgbiped.envs.simulation.rollout import check_push
 
         try:
-            from cpgbiped.envs.gaits.criteria import SETTLE_S
-
             check_push(push, SETTLE_S + SECONDS)
         except InputError as e:
             ap.error(str(e))

@@ -430,7 +430,7 @@ def cmd_tune(a) -> int:
     from cpgbiped.cpg.optimize import RunSettings
     from cpgbiped.envs.control.controller import GAINS_FILE
     from cpgbiped.envs.search.controller_tuning import (HORIZON, SHORTFALL, WORST, TuneSettings,
-                                                          check_gaits, tune, variables)
+                                                          check_gaits, tune, values_of, variables)
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
     out_dir(a.out)
@@ -445,8 +445,6 @@ def cmd_tune(a) -> int:
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
-
-    from cpgbiped.envs.search.controller_tuning import values_of
 
     # a bad starting file, or one without the start-up gains a search names, is refused
     # before any work

@@ -379,33 +379,36 @@ def variables(settings: TuneSettings) -> list[tuple[str, float, float]]:
     return out + startup
 
 
+def _slot(d: dict, name: str) -> tuple[dict, str]:
+    """The table of ``d`` (:func:`params_to_dict`) that holds ``name``, and its key there:
+    "startup.<corner>.<gain>", "<corner>.<gain>" or a shared name."""
+    if name.startswith(STARTUP):
+        if "startup" not in d:
+            raise InputError("the start-up gains are searched only from a gains file that has "
+                             "them (its \"startup\" section; cpgbiped.envs.search."
+                             "controller_tuning.set_startup writes one)")
+        c, g = name[len(STARTUP):].split(".")
+        return d["startup"]["corners"][c], g
+    if "." in name:
+        c, g = name.split(".")
+        return d["corners"][c], g
+    return d["shared"], name
+
+
 def with_values(base: ControlParams, names: list[str], x) -> ControlParams:
     """``base`` with the named parameters set to ``x``."""
-    d = params_to_dict(base)
-    values_of(base, names)  # start-up names need a file with start-up gains
-    for n, v in zip(names, np.asarray(x, float)):
-        if n.startswith(STARTUP):
-            c, g = n[len(STARTUP):].split(".")
-            d["startup"]["corners"][c][g] = float(v)
-        elif "." in n:
-            c, g = n.split(".")
-            d["corners"][c][g] = float(v)
-        else:
-            d["shared"][n] = float(v)
     from cpgbiped.envs.control.controller import params_from_dict
 
+    d = params_to_dict(base)
+    for n, v in zip(names, np.asarray(x, float)):
+        table, key = _slot(d, n)
+        table[key] = float(v)
     return params_from_dict(d)
 
 
 def values_of(p: ControlParams, names: list[str]) -> np.ndarray:
     d = params_to_dict(p)
-    if any(n.startswith(STARTUP) for n in names) and "startup" not in d:
-        raise InputError("the start-up gains are searched only from a gains file that has "
-                          "them (its \"startup\" section; cpgbiped.envs.search."
-                          "controller_tuning.set_startup writes one)")
-    return np.array([d["startup"]["corners"][n[len(STARTUP):].split(".")[0]][n.split(".")[-1]]
-                     if n.startswith(STARTUP) else d["corners"][n.split(".")[0]][n.split(".")[1]]
-                     if "." in n else d["shared"][n] for n in names])
+    return np.array([table[key] for table, key in (_slot(d, n) for n in names)])
 
 
 def target_speed(gait: str) -> float | None:
@@ -676,6 +679,7 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
             "apex_height_m", "stride_cv", "ankle_excursion_deg", "fell_at_s_horizon"]
     rows = []
     n_g = len(settings.gaits)
+    best_costs = problem.gait_costs(summaries[k])
     for c, cond in enumerate(problem.conditions):
         for j, g in enumerate(settings.gaits):
             s = summaries[k][c * n_g + j]
@@ -683,9 +687,7 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                          cond.get("friction_scale", 1.0),
                          cond.get("push", ""), cond.get("weights", {}).get(g, ""),
                          cond.get("feedback", 0.0),
-                         round(rollout_cost(g, s, settings.seconds,
-                                            shortfall=settings.shortfall_weight,
-                                            survival_only=bool(settings.survival_mask()[c])), 4),
+                         round(float(best_costs[c, j]), 4),
                          s["fell"], s["physical_gait"], _r(s["speed_mps"]), _r(s["froude"]),
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
