@@ -177,6 +177,33 @@ def test_survival_only_conditions_count_the_seconds_upright_alone():
     assert gc[1, 0] == 0.0
 
 
+def test_target_froude_moves_the_progress_target():
+    """--target-froude run=0.26: that gait's progress term pays for the distance short of
+    v* T with v* = sqrt(Fr g L); a walk already faster than a lower target's v* pays nothing,
+    and below the default target (Fr 0.11: 0.96 m/s on the 0.862 m leg) it pays
+    PROGRESS (1 - v / v*), computed here from the formula, not the code."""
+    from cpgbiped.envs.search.controller_tuning import (PROGRESS, ControllerTuningProblem,
+                                                          TARGET_FROUDE)
+
+    s = walk_summary(speed=0.8)
+    v_default = np.sqrt(TARGET_FROUDE["walk"] * 9.81 * 0.862)
+    low = rollout_cost("walk", s, 10.0, target_froude=0.05)  # v* 0.65 m/s < 0.8
+    default = rollout_cost("walk", s, 10.0)
+    assert default - low == pytest.approx(PROGRESS * (1.0 - 0.8 / v_default), abs=0.02)
+    settings = TuneSettings(("walk", "run"), target_froude=(("walk", 0.05),))
+    assert settings.froude_target("walk") == 0.05
+    assert settings.froude_target("run") == TARGET_FROUDE["run"]
+    assert settings.froude_target("jump") is None
+    prob = ControllerTuningProblem(TuneSettings(("walk",), n_conditions=1,
+                                                target_froude=(("walk", 0.05),)), CONTROL)
+    assert prob.gait_costs([s])[0, 0] == pytest.approx(low)
+    for bad, msg in ((("jump", 0.2),), "only walk, run"), ((("run", 0.2),), "not among"), \
+                    ((("walk", 0.0),), "must be in"), ((("walk", float("nan")),), "must be in"):
+        with pytest.raises(InputError, match=msg):
+            TuneSettings(("walk", "jump") if bad[0][0] == "jump" else ("walk",),
+                         target_froude=bad)
+
+
 def test_the_worst_condition_weighs_as_told():
     """CMA-ES's single objective and the final pick are mean + w x max over the conditions:
     w = 0.5 by default (the committed chain's), 0 the mean alone."""

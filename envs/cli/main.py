@@ -403,6 +403,22 @@ def condition_ids_arg(text: str) -> tuple[int, ...]:
         raise argparse.ArgumentTypeError(str(e)) from None
 
 
+def target_froude_arg(text: str) -> tuple[tuple[str, float], ...]:
+    """``--target-froude``: GAIT=FR pairs, comma-separated (run=0.26 or walk=0.1,run=0.26)."""
+    pairs = []
+    for part in str(text).split(","):
+        gait, eq, fr = part.partition("=")
+        if not eq:
+            raise argparse.ArgumentTypeError(
+                f"must be GAIT=FR pairs such as run=0.26, got {text!r}")
+        pairs.append((gait.strip(), _number(fr, -1e300, 1e300, False,
+                                            "must be a finite number")))
+    gaits = [g for g, _ in pairs]
+    if len(set(gaits)) != len(gaits):
+        raise argparse.ArgumentTypeError(f"names a gait twice: {text!r}")
+    return tuple(pairs)
+
+
 def conditions_arg(text: str) -> tuple[int, tuple[int, ...]]:
     """``--conditions``: N (the first N tuning conditions) or numbers and ranges (1-8,21-24);
     returns (how many, their numbers or () for the first N)."""
@@ -441,7 +457,7 @@ def cmd_tune(a) -> int:
                             n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "",
                             SHORTFALL if a.shortfall_weight is None else a.shortfall_weight,
                             WORST if a.worst_weight is None else a.worst_weight,
-                            a.survival_only)
+                            a.survival_only, a.target_froude)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1359,6 +1375,12 @@ def build_parser() -> argparse.ArgumentParser:
                     help="conditions (numbers and ranges, among --conditions) scored on the "
                          "seconds upright and the fall alone, not the speed or the criteria: "
                          "a floor where staying up is all that is asked (e.g. 29-36)")
+    sp.add_argument("--target-froude", type=target_froude_arg, default=(),
+                    metavar="GAIT=FR[,GAIT=FR]",
+                    help="the progress target's Froude number for walk or run (default walk "
+                         "0.11, run 0.33; a target just above the criteria's minimum, e.g. "
+                         "run=0.26, asks the search to keep the speed rather than gain more; "
+                         "(0, 1])")
     sp.add_argument("--worst-weight", type=finite_arg, default=None, metavar="W",
                     help="weight of the worst condition's cost beside the mean (CMA-ES "
                          "minimises mean + W max, and the best point is picked so; default "

@@ -45,6 +45,8 @@ standing is led towards walking instead of towards not moving.
 A candidate's cost sums its gaits' costs per condition; over the conditions, CMA-ES minimises
 mean + w max (the worst condition counts; w = WORST = 0.5 unless ``--worst-weight`` sets it),
 NSGA-II the pair (mean, max), and the best point is the least mean + w max.
+``--target-froude run=0.26`` moves a gait's progress target (v* of that Froude number): a
+target just above the criteria's minimum asks a search to keep the speed, not to gain more.
 ``--survival-only 29-36`` scores the named conditions on SURVIVAL and FALL alone (a slippery
 floor where staying up is all that is asked, not the speed or the criteria).
 The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
@@ -115,6 +117,7 @@ if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHAR
     raise ImportError("the tuning box and envs.control_kernel's parameter layout disagree")
 
 TARGET_FROUDE = {"walk": 0.11, "run": 0.33}  # progress target (criteria: Fr >= 0.08, 0.25)
+MAX_TARGET_FROUDE = 1.0  # --target-froude's bound (a walk-run transition's Fr 0.5, doubled)
 SURVIVAL, PROGRESS, FALL, SHORTFALL, MARGIN = 10.0, 10.0, 5.0, 3.0, 0.03
 WORST = 0.5  # the worst condition's weight beside the mean (--worst-weight)
 MAX_WORST_WEIGHT = 10.0  # --worst-weight's bound (a sanity bound, not a tuned value)
@@ -279,6 +282,12 @@ class TuneSettings:
     shortfall_weight: float = SHORTFALL  # weight of the pattern and quality shortfalls
     worst_weight: float = WORST  # CMA-ES and the final pick minimise mean + worst_weight x max
     survival_only: tuple[int, ...] = ()  # 1-based conditions scored on seconds upright and fall
+    target_froude: tuple[tuple[str, float], ...] = ()  # (gait, Fr): progress targets replacing
+    #                                                    TARGET_FROUDE's for those gaits
+
+    def froude_target(self, gait: str) -> float | None:
+        """The Froude number of ``gait``'s progress target (None: no progress term)."""
+        return dict(self.target_froude).get(gait, TARGET_FROUDE.get(gait))
 
     def ids(self) -> tuple[int, ...]:
         """The 1-based numbers of :meth:`conditions`, in order."""
@@ -339,6 +348,15 @@ class TuneSettings:
         if not (np.isfinite(self.worst_weight) and 0.0 <= self.worst_weight <= MAX_WORST_WEIGHT):
             raise InputError(f"--worst-weight must be in [0, {MAX_WORST_WEIGHT:g}], "
                              f"got {self.worst_weight}")
+        for g, fr in self.target_froude:
+            if g not in TARGET_FROUDE:
+                raise InputError(f"--target-froude {g}: only {', '.join(TARGET_FROUDE)} have a "
+                                 f"progress target")
+            if g not in self.gaits:
+                raise InputError(f"--target-froude {g}: not among the gaits scored (--gait)")
+            if not (np.isfinite(fr) and 0.0 < fr <= MAX_TARGET_FROUDE):
+                raise InputError(f"--target-froude {g}={fr}: the Froude number must be in "
+                                 f"(0, {MAX_TARGET_FROUDE:g}]")
         if not (np.isfinite(self.shortfall_weight)
                 and 0.0 <= self.shortfall_weight <= MAX_SHORTFALL_WEIGHT):
             raise InputError(f"--shortfall-weight must be in [0, {MAX_SHORTFALL_WEIGHT:g}], "
@@ -411,24 +429,27 @@ def values_of(p: ControlParams, names: list[str]) -> np.ndarray:
     return np.array([table[key] for table, key in (_slot(d, n) for n in names)])
 
 
-def target_speed(gait: str) -> float | None:
+def target_speed(gait: str, froude: float | None = None) -> float | None:
+    """v* = sqrt(Fr g L) (m/s) of ``froude``, else of TARGET_FROUDE[gait] (None: no target)."""
     from cpgbiped.envs.simulation.biped import body_constants
 
-    fr = TARGET_FROUDE.get(gait)
+    fr = TARGET_FROUDE.get(gait) if froude is None else froude
     return None if fr is None else float(np.sqrt(fr * 9.81 * body_constants()[0]))
 
 
 def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S,
-                 shortfall: float = SHORTFALL, survival_only: bool = False) -> float:
+                 shortfall: float = SHORTFALL, survival_only: bool = False,
+                 target_froude: float | None = None) -> float:
     """The cost of one rollout summary (:func:`cpgbiped.envs.simulation.trials.run_control_trial`); see the module
     docstring. ``shortfall``: the weight of the pattern and quality shortfalls;
     ``survival_only``: the seconds upright and the fall alone (a condition where staying up is
-    all that is asked, ``--survival-only``)."""
+    all that is asked, ``--survival-only``); ``target_froude``: the progress target's Froude
+    number (None: TARGET_FROUDE's, ``--target-froude``)."""
     up = float(np.clip(s["survived_s"] - settle_s, 0.0, seconds))
     c = SURVIVAL * (1.0 - up / seconds)
     if survival_only:
         return float(c + (FALL if s["fell"] else 0.0))
-    v = target_speed(gait)
+    v = target_speed(gait, target_froude)
     if v is not None:
         d = float(s["distance_m"]) if np.isfinite(s["distance_m"]) else 0.0
         c += PROGRESS * (1.0 - min(d, v * seconds) / (v * seconds))
@@ -477,7 +498,8 @@ class ControllerTuningProblem(Problem):
         only = self.settings.survival_mask()
         return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds,
                                        shortfall=self.settings.shortfall_weight,
-                                       survival_only=bool(only[c]))
+                                       survival_only=bool(only[c]),
+                                       target_froude=self.settings.froude_target(g))
                           for j, g in enumerate(self.settings.gaits)] for c in range(n_c)])
 
     def reference_costs(self) -> np.ndarray:
