@@ -49,6 +49,7 @@ def test_help_reads_like_a_manual():
     (["tune", "--gait", "walk", "--worst-weight", "nan"], "must be a finite number"),
     (["tune", "--gait", "walk", "--survival-only", "40"], "numbered 1-36"),
     (["tune", "--gait", "walk", "--target-froude", "walk"], "must be GAIT=FR pairs"),
+    (["tune", "--gait", "walk", "--progress-weight", "1001"], "must be in [0, 1000]"),
     (["tune", "--gait", "walk", "--target-froude", "walk=inf"], "must be a finite number"),
     (["tune", "--gait", "walk", "--target-froude", "walk=2"], "must be in (0, 1]"),
     (["tune", "--gait", "walk", "--target-froude", "run=0.3"], "run: not among the gaits"),

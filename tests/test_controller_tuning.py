@@ -197,6 +197,14 @@ def test_target_froude_moves_the_progress_target():
     prob = ControllerTuningProblem(TuneSettings(("walk",), n_conditions=1,
                                                 target_froude=(("walk", 0.05),)), CONTROL)
     assert prob.gait_costs([s])[0, 0] == pytest.approx(low)
+    # --progress-weight W scales that term alone: W = 3 PROGRESS triples the shortfall's cost
+    tripled = rollout_cost("walk", s, 10.0, progress=3 * PROGRESS)
+    assert tripled - default == pytest.approx(2 * (default - low), rel=1e-9)
+    heavy = ControllerTuningProblem(TuneSettings(("walk",), n_conditions=1,
+                                                 progress_weight=3 * PROGRESS), CONTROL)
+    assert heavy.gait_costs([s])[0, 0] == pytest.approx(tripled)
+    with pytest.raises(InputError, match="--progress-weight must be in"):
+        TuneSettings(("walk",), progress_weight=-1.0)
     for bad, msg in ((("jump", 0.2),), "only walk, run"), ((("run", 0.2),), "not among"), \
                     ((("walk", 0.0),), "must be in"), ((("walk", float("nan")),), "must be in"):
         with pytest.raises(InputError, match=msg):

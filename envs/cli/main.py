@@ -445,7 +445,8 @@ def only_arg(text: str) -> tuple[str, ...]:
 def cmd_tune(a) -> int:
     from cpgbiped.cpg.optimize import RunSettings
     from cpgbiped.envs.control.controller import GAINS_FILE
-    from cpgbiped.envs.search.controller_tuning import (HORIZON, SHORTFALL, WORST, TuneSettings,
+    from cpgbiped.envs.search.controller_tuning import (HORIZON, PROGRESS, SHORTFALL, WORST,
+                                                          TuneSettings,
                                                           check_gaits, tune, values_of, variables)
     from cpgbiped.envs.simulation.trials import DaskRunner, PoolRunner, SerialRunner
 
@@ -457,7 +458,8 @@ def cmd_tune(a) -> int:
                             n_cond, a.sigma, only_arg(a.only), ids, guard, a.guard_gains or "",
                             SHORTFALL if a.shortfall_weight is None else a.shortfall_weight,
                             WORST if a.worst_weight is None else a.worst_weight,
-                            a.survival_only, a.target_froude)
+                            a.survival_only, a.target_froude,
+                            PROGRESS if a.progress_weight is None else a.progress_weight)
     rs = RunSettings(a.pop, a.gens, a.seed, a.checkpoint_every)
     start = a.start or str(GAINS_FILE)
     from cpgbiped.envs.control.controller import read_gains
@@ -1381,6 +1383,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "0.11, run 0.33; a target just above the criteria's minimum, e.g. "
                          "run=0.26, asks the search to keep the speed rather than gain more; "
                          "(0, 1])")
+    sp.add_argument("--progress-weight", type=finite_arg, default=None, metavar="W",
+                    help="weight of the progress term (walk and run: the distance short of "
+                         "the target speed's; default 10, as the seconds upright; 0-1000)")
     sp.add_argument("--worst-weight", type=finite_arg, default=None, metavar="W",
                     help="weight of the worst condition's cost beside the mean (CMA-ES "
                          "minimises mean + W max, and the best point is picked so; default "

@@ -46,7 +46,9 @@ A candidate's cost sums its gaits' costs per condition; over the conditions, CMA
 mean + w max (the worst condition counts; w = WORST = 0.5 unless ``--worst-weight`` sets it),
 NSGA-II the pair (mean, max), and the best point is the least mean + w max.
 ``--target-froude run=0.26`` moves a gait's progress target (v* of that Froude number): a
-target just above the criteria's minimum asks a search to keep the speed, not to gain more.
+target just above the criteria's minimum asks a search to keep the speed, not to gain more; ``--progress-weight W`` sets PROGRESS's weight
+(default 10, the same as SURVIVAL's: a speed short of v* by a tenth costs what a fall a tenth
+into the window does).
 ``--survival-only 29-36`` scores the named conditions on SURVIVAL and FALL alone (a slippery
 floor where staying up is all that is asked, not the speed or the criteria).
 The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
@@ -122,6 +124,7 @@ SURVIVAL, PROGRESS, FALL, SHORTFALL, MARGIN = 10.0, 10.0, 5.0, 3.0, 0.03
 WORST = 0.5  # the worst condition's weight beside the mean (--worst-weight)
 MAX_WORST_WEIGHT = 10.0  # --worst-weight's bound (a sanity bound, not a tuned value)
 MAX_SHORTFALL_WEIGHT = 100.0  # --shortfall-weight's bound (a sanity bound, not a tuned value)
+MAX_PROGRESS_WEIGHT = 1000.0  # --progress-weight's bound (a sanity bound, not a tuned value)
 POSTURE, LEAN_FREE_DEG = 1.0, 10.0  # per 10 deg of mean trunk lean beyond 10 deg
 # The guard (--guard): a guarded gait's cost in a condition may exceed its cost under the
 # guard's gains by GUARD_TOL (the rollouts are deterministic, but a body this chaotic moves
@@ -284,6 +287,7 @@ class TuneSettings:
     survival_only: tuple[int, ...] = ()  # 1-based conditions scored on seconds upright and fall
     target_froude: tuple[tuple[str, float], ...] = ()  # (gait, Fr): progress targets replacing
     #                                                    TARGET_FROUDE's for those gaits
+    progress_weight: float = PROGRESS  # weight of the progress term (walk and run)
 
     def froude_target(self, gait: str) -> float | None:
         """The Froude number of ``gait``'s progress target (None: no progress term)."""
@@ -357,6 +361,10 @@ class TuneSettings:
             if not (np.isfinite(fr) and 0.0 < fr <= MAX_TARGET_FROUDE):
                 raise InputError(f"--target-froude {g}={fr}: the Froude number must be in "
                                  f"(0, {MAX_TARGET_FROUDE:g}]")
+        if not (np.isfinite(self.progress_weight)
+                and 0.0 <= self.progress_weight <= MAX_PROGRESS_WEIGHT):
+            raise InputError(f"--progress-weight must be in [0, {MAX_PROGRESS_WEIGHT:g}], "
+                             f"got {self.progress_weight}")
         if not (np.isfinite(self.shortfall_weight)
                 and 0.0 <= self.shortfall_weight <= MAX_SHORTFALL_WEIGHT):
             raise InputError(f"--shortfall-weight must be in [0, {MAX_SHORTFALL_WEIGHT:g}], "
@@ -439,12 +447,13 @@ def target_speed(gait: str, froude: float | None = None) -> float | None:
 
 def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S,
                  shortfall: float = SHORTFALL, survival_only: bool = False,
-                 target_froude: float | None = None) -> float:
+                 target_froude: float | None = None, progress: float = PROGRESS) -> float:
     """The cost of one rollout summary (:func:`cpgbiped.envs.simulation.trials.run_control_trial`); see the module
     docstring. ``shortfall``: the weight of the pattern and quality shortfalls;
     ``survival_only``: the seconds upright and the fall alone (a condition where staying up is
     all that is asked, ``--survival-only``); ``target_froude``: the progress target's Froude
-    number (None: TARGET_FROUDE's, ``--target-froude``)."""
+    number (None: TARGET_FROUDE's, ``--target-froude``); ``progress``: its weight
+    (``--progress-weight``)."""
     up = float(np.clip(s["survived_s"] - settle_s, 0.0, seconds))
     c = SURVIVAL * (1.0 - up / seconds)
     if survival_only:
@@ -452,7 +461,7 @@ def rollout_cost(gait: str, s: dict, seconds: float, settle_s: float = SETTLE_S,
     v = target_speed(gait, target_froude)
     if v is not None:
         d = float(s["distance_m"]) if np.isfinite(s["distance_m"]) else 0.0
-        c += PROGRESS * (1.0 - min(d, v * seconds) / (v * seconds))
+        c += progress * (1.0 - min(d, v * seconds) / (v * seconds))
     if s["fell"]:
         return c + FALL
     c += shortfall * CRITERIA[gait].shortfall(s, MARGIN)
@@ -499,7 +508,8 @@ class ControllerTuningProblem(Problem):
         return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds,
                                        shortfall=self.settings.shortfall_weight,
                                        survival_only=bool(only[c]),
-                                       target_froude=self.settings.froude_target(g))
+                                       target_froude=self.settings.froude_target(g),
+                                       progress=self.settings.progress_weight)
                           for j, g in enumerate(self.settings.gaits)] for c in range(n_c)])
 
     def reference_costs(self) -> np.ndarray:
