@@ -63,6 +63,7 @@ def test_help_reads_like_a_manual():
     (["tune", "--gait", "walk", "--guard", "walk", "--guard-gains", "nope.json"], "nope.json"),
     (["validate", "--push", "6", "5", "--push-s", "0.001"], "at least one control tick"),
     (["robustness", "--push-s", "nan"], "must be a number of seconds in [0.004, 1]"),
+    (["robustness", "--push-after", "1"], "must be a number of seconds in [2, 120]"),
     (["log", "--rrd", "x.rrd", "--push", "6", "5", "--push-s", "2"], "[0.004, 1]"),
     (["render", "--out", "x.mp4", "--seconds", "2", "--push", "6", "5"], "lies outside the rollout"),
     (["validate", "--push-s", "0.1"], "--push-s needs --push"),
@@ -114,6 +115,11 @@ def test_the_push_duration_bounds_the_parser_restates_are_the_library_s():
     from cpgbiped.envs.simulation.rollout import MAX_PUSH_S, PUSH_TICK_S
 
     assert (main.PUSH_TICK_S, main.MAX_PUSH_S, main.PUSH_S) == (PUSH_TICK_S, MAX_PUSH_S, PUSH_S)
+    from cpgbiped.envs.experiments.robustness import MAX_PUSH_AFTER_S, PUSH_AFTER_S
+    from cpgbiped.envs.gaits.criteria import SETTLE_S
+
+    assert (main.PUSH_AFTER_S, main.MAX_PUSH_AFTER_S, main.SETTLE_S_CLI) == (
+        PUSH_AFTER_S, MAX_PUSH_AFTER_S, SETTLE_S)
 
 
 def test_a_push_is_its_impulse_spread_over_whole_control_ticks():

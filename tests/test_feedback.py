@@ -221,6 +221,22 @@ def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fa
     assert (not best or not fails(best)) and fails(nxt)
 
 
+def test_push_after_moves_the_pushes_to_a_later_stride():
+    """robustness --push-after S: phase 0 is the first left touchdown at or after S seconds
+    (the issue's 6 s by default), so a settled gait can be pushed; the stride is the
+    unperturbed rollout's, found here from its contacts."""
+    from cpgbiped.envs.experiments.robustness import push_envelope
+    from cpgbiped.envs.gaits.gait_metrics import debounce, edges
+
+    net = build("ml", "walk")
+    rec = rollout(net, 20.0, poses=False)
+    td, _ = edges(rec.t, debounce(rec.contact[:, 0], rec.dt))
+    for after in (6.0, 12.0):
+        env = push_envelope(net, 0.0, phases=(0.0,), ladder=(2.5,), after_s=after)
+        assert env["stride"]["t0_s"] == pytest.approx(td[td >= after][0], abs=1e-9)
+        assert after <= env["stride"]["t0_s"] < after + 1.5  # within one walk stride (1.07 s)
+
+
 # -- what issue 21 asks and the closed loop does not reach (measured, README "Feedback") ----
 def test_the_jump_survives_the_test_conditions_with_feedback():
     """Issue 21: with feedback at the recommended gain the jump preset does not fall in any of

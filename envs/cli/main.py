@@ -83,6 +83,14 @@ def finite_arg(text: str) -> float:
 # they agree): one control tick up to a second; the default SCONE's (Tutorial 4c: 100 N held
 # for 0.2 s).
 PUSH_TICK_S, MAX_PUSH_S, PUSH_S = 0.004, 1.0, 0.2
+# robustness's push window (envs.experiments.robustness.PUSH_AFTER_S, MAX_PUSH_AFTER_S and
+# envs.gaits.criteria.SETTLE_S, restated likewise; checked in the same test)
+PUSH_AFTER_S, MAX_PUSH_AFTER_S, SETTLE_S_CLI = 6.0, 120.0, 2.0
+
+
+def push_after_arg(text: str) -> float:
+    return _number(text, SETTLE_S_CLI, MAX_PUSH_AFTER_S, False,
+                   f"must be a number of seconds in [{SETTLE_S_CLI:g}, {MAX_PUSH_AFTER_S:g}]")
 
 
 def push_seconds_arg(text: str) -> float:
@@ -793,7 +801,7 @@ def cmd_robustness(a) -> int:
     net, label = _network(a)
     net.period()
     gains = _gains_to_compare(a, net.kind)
-    res = robustness(net, a.gait, gains, push_s=a.push_s)
+    res = robustness(net, a.gait, gains, push_s=a.push_s, after_s=a.push_after)
     res["source"] = label
     stem = os.path.join(a.out, f"robustness_{net.kind}_{net.preset}")
     with io.all_or_nothing():  # the table and its picture land together
@@ -802,8 +810,8 @@ def cmd_robustness(a) -> int:
     if a.json:
         print(io.to_json(res))
     else:
-        print(f"{label}: push envelope (impulse survived, N s, at stride phases; each push "
-              f"held {res['push_s']:g} s), friction "
+        print(f"{label}: push envelope (impulse survived, N s, at stride phases from "
+              f"{res['push_after_s']:g} s; each push held {res['push_s']:g} s), friction "
               f"x0.5/0.7/1.3/2.0 and 8 random CPG states; target {a.gait}")
         print(table(res))
         print(f"wrote {stem}.json, {stem}.png")
@@ -1112,8 +1120,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("robustness", cmd_robustness, "push envelope, friction and CPG-state survival",
              """\
         The robustness envelope of a gait, as SCONE's perturbation tutorials measure it:
-        horizontal pushes on the torso at four phases of the stride (after 6 s; phase 0 a
-        left touchdown), forwards and backwards, the impulse climbing 2.5, 5, 7.5, ... 40 N s
+        horizontal pushes on the torso at four phases of the stride (after 6 s, or
+        --push-after S; phase 0 a left touchdown), forwards and backwards, the impulse climbing 2.5, 5, 7.5, ... 40 N s
         until the body falls within 5 s; floor friction x0.5, 0.7, 1.3, 2.0; eight random
         initial CPG states (seeds 20-27). With --feedback, open loop (K = 0) and the gain K
         side by side. Writes --out/robustness_<network>_<preset>.json and .png (impulse
@@ -1123,6 +1131,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help=f"how long each push's force is held, s (default {PUSH_S:g}, as "
                          f"SCONE's perturbed-gait tutorial; {PUSH_TICK_S:g}: one control tick, "
                          f"a blow of the same impulse)")
+    sp.add_argument("--push-after", type=push_after_arg, default=PUSH_AFTER_S, metavar="S",
+                    help=f"the pushes' stride starts at the first left touchdown after S "
+                         f"seconds of simulation (default {PUSH_AFTER_S:g}, the issue's; later, "
+                         f"e.g. 12, pushes a gait that has settled; "
+                         f"[{SETTLE_S_CLI:g}, {MAX_PUSH_AFTER_S:g}])")
     sp.add_argument("--out", default="out/robustness", metavar="DIR",
                     help="folder for the JSON and the picture (default out/robustness)")
     sp.add_argument("--json", action="store_true", help="print JSON")

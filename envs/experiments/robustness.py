@@ -41,7 +41,8 @@ from cpgbiped.envs.simulation.rollout import rollout
 PUSH_S = 0.2  # s: how long a push's force is held (SCONE Tutorial 4c)
 PUSH_PHASES = (0.0, 0.25, 0.5, 0.75)
 IMPULSE_LADDER_NS = (2.5, 5.0, 7.5, 10.0, 12.5, 15.0, 20.0, 25.0, 30.0, 40.0)
-PUSH_AFTER_S = 6.0
+PUSH_AFTER_S = 6.0  # the issue's push time; --push-after sets another (a settled gait's)
+MAX_PUSH_AFTER_S = 120.0
 HOLD_S = 5.0
 FRICTIONS = (0.5, 0.7, 1.3, 2.0)
 RANDOM_SEEDS = tuple(range(20, 28))
@@ -129,19 +130,21 @@ def condition_survival(network: Network, gait: str | None, K: float) -> dict:
 
 
 def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float | None = None,
-               push_s: float = PUSH_S) -> dict:
+               push_s: float = PUSH_S, after_s: float = PUSH_AFTER_S) -> dict:
     """The envelope and the condition survival for each feedback gain in ``gains``; each push's
-    force held for ``push_s`` seconds."""
+    force held for ``push_s`` seconds, the pushes' stride from the first left touchdown at or
+    after ``after_s`` (s of simulation, settling included)."""
     if mass_kg is None:
         from cpgbiped.envs.simulation.biped import body_constants
 
         mass_kg = body_constants()[1]
     res = {"network": network.kind, "preset": network.preset, "gait": gait,
            "mass_kg": mass_kg, "hold_s": HOLD_S, "push_s": float(push_s),
+           "push_after_s": float(after_s),
            "ladder_ns": list(IMPULSE_LADDER_NS),
            "by_gain": []}
     for K in gains:
-        env = push_envelope(network, K, push_s=push_s)
+        env = push_envelope(network, K, push_s=push_s, after_s=after_s)
         for name in ("forward", "backward"):
             env[f"{name}_min_ns"] = float(min(env[name]))
             env[f"{name}_min_ns_per_kg"] = float(min(env[name])) / mass_kg
