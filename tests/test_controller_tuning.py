@@ -226,7 +226,7 @@ def test_the_worst_condition_weighs_as_told():
 
 
 def test_conditions_can_be_picked_by_number():
-    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-36,
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-40,
     reversed ranges and text are refused."""
     from cpgbiped.envs.search.controller_tuning import condition_ids
 
@@ -237,11 +237,11 @@ def test_conditions_can_be_picked_by_number():
     assert s.conditions() == every[:8] + every[20:24]
     assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
     assert condition_ids("3,3,1") == (3, 1)
-    for bad in ("0-3", "20-37", "5-2", "a", "1-", ""):
+    for bad in ("0-3", "20-41", "5-2", "a", "1-", ""):
         with pytest.raises(InputError):
             condition_ids(bad)
     with pytest.raises(InputError):
-        TuneSettings(("walk",), n_conditions=1, condition_ids=(37,))
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(41,))
     # 25-28: pushes twice the largest of the conditions before them, as many forwards as
     # backwards, each from a CPG state of its own
     big = [c["push"] for c in every[24:28]]
@@ -255,7 +255,16 @@ def test_conditions_can_be_picked_by_number():
     assert all(c.get("friction_scale", 1.0) > 0.4 for c in every[:28])
     from tests.test_physics import PERTURBATIONS
     assert min(c["friction_scale"] for c in PERTURBATIONS if "friction_scale" in c) > 0.4
-    assert len({c["cpg_seed"] for c in every}) == len(every) == 36
+    # 37-40: 5 N s held 0.2 s (the robustness command's push), both ways, at 12.3 and 12.8 s:
+    # later than every other condition's push (at most 6.8 s), when the run has settled
+    settled = [c["push"] for c in every[36:40]]
+    assert all(abs(i) == 5.0 and held == 0.2 for _, i, held in settled)
+    assert sum(i > 0 for _, i, _ in settled) == sum(i < 0 for _, i, _ in settled) == 2
+    assert min(t for t, _, _ in settled) > 12.0 > max(
+        c["push"][0] for c in every[:36] if "push" in c)
+    with pytest.raises(InputError, match="after the end"):
+        TuneSettings(("run",), n_conditions=1, condition_ids=(37,), seconds=10.0)
+    assert len({c["cpg_seed"] for c in every}) == len(every) == MAX_CONDITIONS == 40
 
 
 def test_the_start_up_gains_are_searched_when_named():
@@ -520,7 +529,7 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * 16
+    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * (MAX_CONDITIONS - 20)
     control = tuple(params_array(CONTROL))
     hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
     ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)

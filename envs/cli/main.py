@@ -1357,10 +1357,12 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=10.0,
                     help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
     sp.add_argument("--conditions", type=conditions_arg, default=(6, ()), metavar="N",
-                    help="tuning conditions per candidate: the first N (1-36, default 6), "
+                    help="tuning conditions per candidate: the first N (1-40, default 6), "
                          "or numbers and ranges such as 1-8,21-24 (21-24: CPG states "
                          "from which the walk network starts in a jump's rhythm; 25-28: "
-                         "pushes of 8 N s; 29-32: a floor of friction x0.4; 33-36: x0.6)")
+                         "pushes of 8 N s; 29-32: a floor of friction x0.4; 33-36: x0.6; "
+                         "37-40: 5 N s pushes held 0.2 s at 12.3 and 12.8 s, a settled gait's, "
+                         "with --seconds 16 or more)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")

@@ -135,7 +135,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 36
+MAX_CONDITIONS = 40
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 # CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
 # starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
@@ -153,6 +153,13 @@ BIG_PUSHES = ((1040, (6.3, 8.0)), (1041, (6.3, -8.0)), (1042, (6.8, 8.0)), (1043
 # x0.5: a start-up that survives it is paid for a margin, not for the tests' floor), then x0.6
 # (the sixth condition's, from more states), from CPG seeds 1052-1059, never a test's.
 SLIPPERY = tuple((1052 + k, 0.4) for k in range(4)) + tuple((1056 + k, 0.6) for k in range(4))
+# Conditions 37-40: a settled gait pushed: 5 N s held 0.2 s (SCONE's form, the product's
+# robustness push) at 12.3 and 12.8 s, both ways, from CPG seeds 1060-1063, never a test's. Every
+# push before them falls at 4.5-6.8 s, while the run still accelerates (1.43 m/s over 5-8 s,
+# 1.55 settled); pushed once settled, the committed run fell in 29-30 of 30 census states
+# (README, "Pushed once settled"). Rollouts must last past the push: --seconds 16 and up.
+SETTLED_PUSHES = ((1060, (12.3, 5.0, 0.2)), (1061, (12.3, -5.0, 0.2)),
+                  (1062, (12.8, 5.0, 0.2)), (1063, (12.8, -5.0, 0.2)))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -202,7 +209,9 @@ def tuning_conditions(n: int) -> list[dict]:
     network's waveform. The twenty-first to twenty-fourth start from :data:`TRANSIENT_SEEDS`
     (the walk network starts in a jump's rhythm), the twenty-fifth to twenty-eighth push the
     torso by 8 N s (:data:`BIG_PUSHES`), the twenty-ninth to thirty-second stand on a floor of
-    friction x0.4 and the thirty-third to thirty-sixth on x0.6 (:data:`SLIPPERY`); pick them with :attr:`TuneSettings.condition_ids`
+    friction x0.4 and the thirty-third to thirty-sixth on x0.6 (:data:`SLIPPERY`), the
+    thirty-seventh to fortieth push a settled gait, 5 N s held 0.2 s at 12.3 and 12.8 s
+    (:data:`SETTLED_PUSHES`); pick them with :attr:`TuneSettings.condition_ids`
     (``--conditions 1-8,21-24``)."""
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
@@ -224,7 +233,8 @@ def tuning_conditions(n: int) -> list[dict]:
            for k in range(min(int(n), 20))]
     out += [{"cpg_seed": s} for s in TRANSIENT_SEEDS[:max(0, int(n) - 20)]]
     out += [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
-    return out + [{"cpg_seed": s, "friction_scale": f} for s, f in SLIPPERY[:max(0, int(n) - 28)]]
+    out += [{"cpg_seed": s, "friction_scale": f} for s, f in SLIPPERY[:max(0, int(n) - 28)]]
+    return out + [{"cpg_seed": s, "push": p} for s, p in SETTLED_PUSHES[:max(0, int(n) - 36)]]
 
 
 def condition_ids(text: str) -> tuple[int, ...]:
