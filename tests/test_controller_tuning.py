@@ -264,6 +264,13 @@ def test_conditions_can_be_picked_by_number():
         c["push"][0] for c in every[:36] if "push" in c)
     with pytest.raises(InputError, match="after the end"):
         TuneSettings(("run",), n_conditions=1, condition_ids=(37,), seconds=10.0)
+    # a held push must end HELD_PUSH_MARGIN_S (1 s) before the rollout: 12.3 + 0.2 + 1 = 13.5 s
+    with pytest.raises(InputError, match="under 1 s after it"):
+        TuneSettings(("run",), n_conditions=1, condition_ids=(37,), seconds=11.4)
+    assert TuneSettings(("run",), n_conditions=1, condition_ids=(37,), seconds=11.5).seconds \
+        == 11.5
+    with pytest.raises(InputError, match="use --seconds 12 or more"):
+        TuneSettings(("run",), n_conditions=1, condition_ids=(40,), seconds=11.5)
     assert len({c["cpg_seed"] for c in every}) == len(every) == MAX_CONDITIONS == 40
 
 

@@ -1121,8 +1121,8 @@ def build_parser() -> argparse.ArgumentParser:
              """\
         The robustness envelope of a gait, as SCONE's perturbation tutorials measure it:
         horizontal pushes on the torso at four phases of the stride (after 6 s, or
-        --push-after S; phase 0 a left touchdown), forwards and backwards, the impulse climbing 2.5, 5, 7.5, ... 40 N s
-        until the body falls within 5 s; floor friction x0.5, 0.7, 1.3, 2.0; eight random
+        --push-after S; phase 0 a left touchdown), forwards and backwards, the impulse
+        climbing 2.5, 5, 7.5, ... 40 N s until the body falls within 5 s; floor friction x0.5, 0.7, 1.3, 2.0; eight random
         initial CPG states (seeds 20-27). With --feedback, open loop (K = 0) and the gain K
         side by side. Writes --out/robustness_<network>_<preset>.json and .png (impulse
         survived against the phase of the push).""")

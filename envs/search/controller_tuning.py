@@ -17,7 +17,9 @@ Conditions. Every candidate drives each named preset under every tuning conditio
 (:func:`tuning_conditions`): a random initial CPG state drawn from a seed of 1000 or more,
 some with another floor friction or a horizontal push on the torso; from the ninth on, the
 walk driven by another walk network or the loop closed
-(:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's.
+(:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's;
+the twenty-first to fortieth: transient CPG states, bigger pushes, slippery floors and pushes
+of a settled gait (:func:`tuning_conditions`).
 The tests and the README report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
@@ -26,9 +28,11 @@ conditions.
 Cost of one rollout (lower is better), from the criteria of :mod:`cpgbiped.envs.gaits.criteria`:
   SURVIVAL (1 - t_up / T)                         T: the measured window, t_up: its part
                                                   before a fall
-  + PROGRESS (1 - min(d, v* T) / (v* T))           walk and run only: d the distance covered
+  + W_p (1 - min(d, v* T) / (v* T))               walk and run only: d the distance covered
                                                   forwards (until a fall), v* the speed of
-                                                  TARGET_FROUDE (above the criteria's minimum)
+                                                  TARGET_FROUDE (above the criteria's minimum;
+                                                  ``--target-froude``), W_p = PROGRESS unless
+                                                  ``--progress-weight`` sets it
   + FALL                                          if it fell (and nothing more), else
   + w_s x Criteria.shortfall (margin MARGIN)      pattern and quality terms; w_s =
                                                   SHORTFALL unless ``--shortfall-weight``
@@ -46,9 +50,9 @@ A candidate's cost sums its gaits' costs per condition; over the conditions, CMA
 mean + w max (the worst condition counts; w = WORST = 0.5 unless ``--worst-weight`` sets it),
 NSGA-II the pair (mean, max), and the best point is the least mean + w max.
 ``--target-froude run=0.26`` moves a gait's progress target (v* of that Froude number): a
-target just above the criteria's minimum asks a search to keep the speed, not to gain more; ``--progress-weight W`` sets PROGRESS's weight
-(default 10, the same as SURVIVAL's: a speed short of v* by a tenth costs what a fall a tenth
-into the window does).
+target just above the criteria's minimum asks a search to keep the speed, not to gain more;
+``--progress-weight W`` sets PROGRESS's weight (default 10, the same as SURVIVAL's: a speed
+short of v* by a tenth costs what a fall a tenth into the window does).
 ``--survival-only 29-36`` scores the named conditions on SURVIVAL and FALL alone (a slippery
 floor where staying up is all that is asked, not the speed or the criteria).
 The guard (``--guard walk``): a guarded gait's cost in a condition may not rise above its cost
@@ -155,9 +159,11 @@ BIG_PUSHES = ((1040, (6.3, 8.0)), (1041, (6.3, -8.0)), (1042, (6.8, 8.0)), (1043
 SLIPPERY = tuple((1052 + k, 0.4) for k in range(4)) + tuple((1056 + k, 0.6) for k in range(4))
 # Conditions 37-40: a settled gait pushed: 5 N s held 0.2 s (SCONE's form, the product's
 # robustness push) at 12.3 and 12.8 s, both ways, from CPG seeds 1060-1063, never a test's. Every
-# push before them falls at 4.5-6.8 s, while the run still accelerates (1.43 m/s over 5-8 s,
+# push before them comes at 4.5-6.8 s, while the run still accelerates (1.43 m/s over 5-8 s,
 # 1.55 settled); pushed once settled, the committed run fell in 29-30 of 30 census states
-# (README, "Pushed once settled"). Rollouts must last past the push: --seconds 16 and up.
+# (README, "Pushed once settled"). A rollout must last HELD_PUSH_MARGIN_S past the push's end
+# (--seconds 12 with condition 40; 16 leaves the body 3 s to fall, as the searches used).
+HELD_PUSH_MARGIN_S = 1.0  # a held push's condition needs this long after the push ends
 SETTLED_PUSHES = ((1060, (12.3, 5.0, 0.2)), (1061, (12.3, -5.0, 0.2)),
                   (1062, (12.8, 5.0, 0.2)), (1063, (12.8, -5.0, 0.2)))
 
@@ -357,6 +363,14 @@ class TuneSettings:
                     f"tuning condition {k} pushes at {cond['push'][0]:g} s, after the end of "
                     f"a {SETTLE_S + self.seconds:g} s rollout: use --seconds above "
                     f"{cond['push'][0] - SETTLE_S:g} or leave condition {k} out")
+            if "push" in cond and len(cond["push"]) > 2:  # a held push: held, then time to fall
+                end = cond["push"][0] + cond["push"][2] + HELD_PUSH_MARGIN_S
+                if end > SETTLE_S + self.seconds + 1e-9:
+                    raise InputError(
+                        f"tuning condition {k} pushes at {cond['push'][0]:g} s for "
+                        f"{cond['push'][2]:g} s: a {SETTLE_S + self.seconds:g} s rollout leaves "
+                        f"under {HELD_PUSH_MARGIN_S:g} s after it to fall in: use --seconds "
+                        f"{end - SETTLE_S:g} or more, or leave condition {k} out")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
         if not (np.isfinite(self.worst_weight) and 0.0 <= self.worst_weight <= MAX_WORST_WEIGHT):
