@@ -182,7 +182,13 @@ def test_an_interrupt_in_the_recording_stream_s_constructor_waits_for_it(tmp_pat
 
     monkeypatch.setattr(rr, "RecordingStream", Interrupted)
     v = validate(build("ml", "walk"), "walk", 1.0)
-    with pytest.raises(KeyboardInterrupt):
-        write_rrd(tmp_path / "x.rrd", {"walk": (v.recording, v.metrics)})
+    # a suite started in the background by a non-interactive shell inherits SIGINT ignored,
+    # and signals_held rightly re-raises into the handler it found: Python's default here
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            write_rrd(tmp_path / "x.rrd", {"walk": (v.recording, v.metrics)})
+    finally:
+        signal.signal(signal.SIGINT, before)
     assert made and made[0].to_native() is not None
     assert not (tmp_path / "x.rrd").exists()
