@@ -1466,6 +1466,21 @@ class Terminated(KeyboardInterrupt):
 
 
 _SIGNALLED: list[int] = []  # signals received during this run of main()
+_CONSOLE: list[bool] = []  # set while main() runs as the console entry point (its process ends)
+
+
+def _quiet_unraisable(unraisable) -> None:
+    """sys.unraisablehook once the console's run is interrupted: a library object the
+    interrupt caught half-built reports its finaliser's error ("Exception ignored in ...")
+    when it is freed, after the run's one line (pyparsing's Forward once in a fresh-clone CI:
+    its __del__ reads an attribute its interrupted __init__ never set). The run is over and
+    its clean-up paths have run; the report is dropped."""
+
+
+def _signalled(signum) -> None:
+    _SIGNALLED.append(signum)
+    if _CONSOLE:
+        sys.unraisablehook = _quiet_unraisable
 
 
 # Where an exception raised by a signal handler would be swallowed ("Exception ignored ...")
@@ -1500,14 +1515,14 @@ def _put_off(signum, frame) -> bool:
 def _on_sigterm(signum, frame):
     if _put_off(signum, frame):
         return
-    _SIGNALLED.append(signum)
+    _signalled(signum)
     raise Terminated()
 
 
 def _on_sigint(signum, frame):
     if _put_off(signum, frame):
         return
-    _SIGNALLED.append(signum)
+    _signalled(signum)
     raise KeyboardInterrupt()
 
 
@@ -1522,6 +1537,7 @@ def main(argv: list[str] | None = None, *, ignore_signals_after: bool = False) -
 
     previous = {}
     _SIGNALLED.clear()
+    _CONSOLE[:] = [True] if ignore_signals_after else []
     if threading.current_thread() is threading.main_thread():
         previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _on_sigterm)}
         if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
