@@ -536,7 +536,8 @@ def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     conds = tuning_conditions(MAX_CONDITIONS)
-    assert [c.get("network", "ml") for c in conds] == ["ml"] * 16 + ["hopf"] * 4 + ["ml"] * (MAX_CONDITIONS - 20)
+    assert [c.get("network", "ml") for c in conds] == (["ml"] * 16 + ["hopf"] * 4
+                                                       + ["ml"] * (MAX_CONDITIONS - 20))
     control = tuple(params_array(CONTROL))
     hopf = run_control_trial(condition_trial("walk", control, conds[16]), 3.0)
     ml = run_control_trial(condition_trial("walk", control, conds[0]), 3.0)

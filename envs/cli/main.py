@@ -1122,10 +1122,11 @@ def build_parser() -> argparse.ArgumentParser:
         The robustness envelope of a gait, as SCONE's perturbation tutorials measure it:
         horizontal pushes on the torso at four phases of the stride (after 6 s, or
         --push-after S; phase 0 a left touchdown), forwards and backwards, the impulse
-        climbing 2.5, 5, 7.5, ... 40 N s until the body falls within 5 s; floor friction x0.5, 0.7, 1.3, 2.0; eight random
-        initial CPG states (seeds 20-27). With --feedback, open loop (K = 0) and the gain K
-        side by side. Writes --out/robustness_<network>_<preset>.json and .png (impulse
-        survived against the phase of the push).""")
+        climbing 2.5, 5, 7.5, ... 40 N s until the body falls within 5 s; floor friction
+        x0.5, 0.7, 1.3, 2.0; eight random initial CPG states (seeds 20-27). With
+        --feedback, open loop (K = 0) and the gain K side by side. Writes
+        --out/robustness_<network>_<preset>.json and .png (impulse survived against the
+        phase of the push).""")
     network_args(sp)
     sp.add_argument("--push-s", type=push_seconds_arg, default=PUSH_S, metavar="S",
                     help=f"how long each push's force is held, s (default {PUSH_S:g}, as "
@@ -1362,7 +1363,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "from which the walk network starts in a jump's rhythm; 25-28: "
                          "pushes of 8 N s; 29-32: a floor of friction x0.4; 33-36: x0.6; "
                          "37-40: 5 N s pushes held 0.2 s at 12.3 and 12.8 s, a settled gait's, "
-                         "with --seconds 16 or more)")
+                         "with --seconds 12 or more)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")

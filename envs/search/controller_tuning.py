@@ -356,21 +356,23 @@ class TuneSettings:
         if extra:
             raise InputError(f"--survival-only {','.join(map(str, extra))}: not among the "
                              f"conditions the search scores ({','.join(map(str, self.ids()))})")
-        for k, cond in zip(self.condition_ids or range(1, self.n_conditions + 1),
-                           self.conditions()):
-            if "push" in cond and cond["push"][0] >= SETTLE_S + self.seconds:
+        total = SETTLE_S + self.seconds
+        for k, cond in zip(self.ids(), self.conditions()):
+            push = cond.get("push")
+            if push is None:
+                continue
+            if push[0] >= total:
                 raise InputError(
-                    f"tuning condition {k} pushes at {cond['push'][0]:g} s, after the end of "
-                    f"a {SETTLE_S + self.seconds:g} s rollout: use --seconds above "
-                    f"{cond['push'][0] - SETTLE_S:g} or leave condition {k} out")
-            if "push" in cond and len(cond["push"]) > 2:  # a held push: held, then time to fall
-                end = cond["push"][0] + cond["push"][2] + HELD_PUSH_MARGIN_S
-                if end > SETTLE_S + self.seconds + 1e-9:
-                    raise InputError(
-                        f"tuning condition {k} pushes at {cond['push'][0]:g} s for "
-                        f"{cond['push'][2]:g} s: a {SETTLE_S + self.seconds:g} s rollout leaves "
-                        f"under {HELD_PUSH_MARGIN_S:g} s after it to fall in: use --seconds "
-                        f"{end - SETTLE_S:g} or more, or leave condition {k} out")
+                    f"tuning condition {k} pushes at {push[0]:g} s, after the end of "
+                    f"a {total:g} s rollout: use --seconds above "
+                    f"{push[0] - SETTLE_S:g} or leave condition {k} out")
+            end = push[0] + push[2] + HELD_PUSH_MARGIN_S if len(push) > 2 else 0.0
+            if end > total + 1e-9:  # a held push: held, then time to fall
+                raise InputError(
+                    f"tuning condition {k} pushes at {push[0]:g} s for {push[2]:g} s: a "
+                    f"{total:g} s rollout leaves under {HELD_PUSH_MARGIN_S:g} s after it to "
+                    f"fall in: use --seconds {end - SETTLE_S:g} or more, or leave condition "
+                    f"{k} out")
         if not (np.isfinite(self.sigma) and 0.0 < self.sigma <= 1.0):
             raise InputError(f"sigma must be in (0, 1], got {self.sigma}")
         if not (np.isfinite(self.worst_weight) and 0.0 <= self.worst_weight <= MAX_WORST_WEIGHT):
