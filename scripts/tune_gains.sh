@@ -104,6 +104,11 @@ stage wp2 --gait walk,run,jump --only 'alternating.*' --guard walk,run,jump --gu
 # rule on tuning states: the walk's duty sat at the criterion's edge.
 python3 scripts/walk_crouch.py "$prev" "$OUT"
 prev="$OUT/wc/gains.json"
+# The hop corner's foot placement (README, "Transitions"): a Raibert hopper's speed term, set by
+# hand after a rule on fresh CPG states; bodies arriving at a walk's or a run's speed in the
+# hop's rhythm brake.
+python3 scripts/hop_placement.py "$prev" "$OUT"
+prev="$OUT/hp/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

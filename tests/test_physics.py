@@ -63,9 +63,10 @@ def others_for(gait: str, cond: dict) -> dict:
 _HOP = "apex 1.6-1.9 cm below 4 cm; drifts back at 0.07 m/s (limit 0.05)"
 
 KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
-    # since the walk's stance knee (2026-12-04): walk and run pass in all 13; the jump falls
-    # from CPG seed 10 (after wp1, wp2 at friction x1.3 at 7.7 s instead)
-    "jump-seed10": ("falls at 7.5 s", False),
+    # since the hop corner's foot placement (2026-12-05, scripts/hop_placement.py): walk and
+    # run pass in all 13; the jump falls at friction x1.3 (from CPG seed 10 at 7.5 s between
+    # the walk's stance knee and it; at friction x1.3 at 7.7 s after wp1, wp2)
+    "jump-friction1.3": ("falls at 8.4 s", False),
     **{f"hop-{cid}": (_HOP, True) for cid in CONDITION_IDS},
 
     # perturbations (non-strict: a fall or a name at a threshold's edge is chaotic)
@@ -74,8 +75,6 @@ KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
     "jump-friction0.5": ("named a hop (the ankle 28.6 deg in stance, below the 30 deg split; "
                          "apex 5.5 cm), -0.049 m/s; fell at 4.4 s after wp1, wp2", False),
     "jump-friction2.0": ("falls at 4.7 s", False),
-    "jump-blow+5": ("falls at 7.9 s (since the walk's stance knee; the backward blow, which "
-                    "felled it at 6.9 s after wp1, wp2, it now keeps)", False),
     "hop-push-5": ("falls at 7.0 s", False),
     "hop-blow-5": ("falls at 6.9 s", False),
 }
