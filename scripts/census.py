@@ -6,12 +6,13 @@ in [--first, --first + --n) and is validated for 20 s after settling, as ``cpgbi
 does, with the committed gains or --gains FILE:
 
     python scripts/census.py walk,run,jump,hop --first 3000 --n 30 [--gains FILE]
-                             [--friction F] [--push T I [--push-s S]] [-v]
+                             [--friction F] [--push T I [--push-s S]] [--feedback [K]] [-v]
 
 --friction scales the floor's friction, --push gives the torso a horizontal impulse of I N s
 at T s (simulation time, settling included), its force held --push-s s (default 0.2, as
 ``validate`` holds it): the perturbations of the
-tests measured over many states instead of one.
+tests measured over many states instead of one. --feedback closes the loop (the body's sensors
+into the CPG, ``cpgbiped validate --feedback``): alone the recommended gain, or K.
 
 Seeds 3000 and up are neither tuning conditions (1000-1099) nor the tests' (10-19).
 Prints, per gait, how many pass every criterion, how many are named their own gait by the
@@ -27,14 +28,14 @@ SECONDS = 20.0  # validate's measured window (after its 2 s of settling)
 def one(job):
     """One preset from one random CPG state under one perturbation: (gait, seed, summary,
     failed criteria)."""
-    gait, seed, gains, friction, push = job
+    gait, seed, gains, friction, push, feedback = job
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL, read_gains
     from cpgbiped.envs.gaits.validate import validate
 
     params = read_gains(gains)[0] if gains else CONTROL
     s = validate(build("ml", gait, seed=seed), gait, SECONDS, params=params,
-                 friction_scale=friction, push=push).summary()
+                 friction_scale=friction, push=push, feedback=feedback).summary()
     return gait, seed, s, s["failures"]
 
 
@@ -55,8 +56,19 @@ def main() -> None:
     ap.add_argument("--matrix", action="store_true",
                     help="also count the states from which every named preset gives its own "
                          "physical gait (the matrix's diagonal, `cpgbiped matrix --seed S`)")
+    ap.add_argument("--feedback", nargs="?", const="recommended", default=None, metavar="K",
+                    help="feed the body's sensors back into the CPG: alone the recommended "
+                         "gain, or K (default: open loop)")
     ap.add_argument("-v", action="store_true", help="one line per failing rollout")
     a = ap.parse_args()
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.cpg.feedback import RECOMMENDED, check_gain
+
+    try:
+        feedback = (0.0 if a.feedback is None else RECOMMENDED["ml"]
+                    if a.feedback == "recommended" else check_gain("ml", a.feedback))
+    except InputError as e:
+        ap.error(str(e))
     gaits = a.gaits.split(",")
     push = (*a.push, a.push_s) if a.push else None
     if push is not None:  # the rollout's own check, before any worker starts
@@ -68,7 +80,7 @@ def main() -> None:
             check_push(push, SETTLE_S + SECONDS)
         except InputError as e:
             ap.error(str(e))
-    jobs = [(g, s, a.gains, a.friction, push) for g in gaits
+    jobs = [(g, s, a.gains, a.friction, push, feedback) for g in gaits
             for s in range(a.first, a.first + a.n)]
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
         res = list(ex.map(one, jobs))
