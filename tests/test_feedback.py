@@ -290,7 +290,7 @@ def test_feedback_doubles_the_push_envelope_or_reaches_half_a_newton_second_per_
     SCONE's perturbed-gait tutorial holds its 100 N (the product's push); "blow": the same
     impulse in one 4 ms control tick. Measured: the walk with feedback 15 N s forwards and
     25 backwards (pushes), 10 and 15 (blows); the run's in _ENVELOPE_SHORTFALLS, 5 forwards
-    (pushes, 2.5 open loop) and 12.5 backwards (blows, 7.5 open loop)."""
+    (pushes, 2.5 open loop) and 15 backwards (blows, 5 open loop)."""
     from cpgbiped.envs.experiments.robustness import PUSH_S, push_envelope
     from cpgbiped.envs.simulation.rollout import PUSH_TICK_S
 

@@ -70,13 +70,13 @@ KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
     **{f"hop-{cid}": (_HOP, True) for cid in CONDITION_IDS},
 
     # perturbations (non-strict: a fall or a name at a threshold's edge is chaotic)
-    "run-friction0.5": ("falls at 1.4 s", False),
-    "run-blow-5": ("falls at 7.6 s", False),
+    "run-friction0.5": ("falls at 1.5 s", False),
+    "run-blow-5": ("falls at 7.5 s", False),
     "jump-friction0.5": ("named a hop (the ankle 28.6 deg in stance, below the 30 deg split; "
                          "apex 5.5 cm), -0.049 m/s; fell at 4.4 s after wp1, wp2", False),
     "jump-friction2.0": ("falls at 4.7 s", False),
     "hop-push-5": ("falls at 7.0 s", False),
-    "hop-blow-5": ("falls at 6.9 s", False),
+    "hop-blow-5": ("falls at 6.8 s", False),
 }
 
 
