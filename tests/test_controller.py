@@ -248,6 +248,36 @@ def test_startup_gains_hand_over_to_the_corners():
                            atol=1e-3)
 
 
+def test_restart_v_returns_the_run_corner_s_start_up_gains_to_a_slow_body():
+    """restart_v (m/s; 0 in the committed gains): in an alternating rhythm the alternating
+    co-activated corner's start-up gains return while the body is slower than restart_v,
+    nu_ac = max(nu, clip((0.9 - sigma) / 0.2) clip(1 - v / restart_v)). On the lifted body at
+    rest (v = 0) with the features at their prior (sigma = 0.5: the gate is open), 30 tau_s
+    after the start, the controls equal those of gains whose run corner is replaced by its
+    start-up corner and no restart (an independent parameter set, to 1e-9); at restart_v = 0
+    they are the corners' own, and the two differ, so the test can fail."""
+    from dataclasses import replace
+
+    from cpgbiped.envs.control.controller import read_gains
+    from cpgbiped.envs.search.controller_tuning import ROOT_GAINS_FILE
+
+    root = read_gains(ROOT_GAINS_FILE)[0]
+    tau = 0.5
+    both = replace(CONTROL, startup=tuple(root.corner(c) for c in K.CORNERS), startup_tau_s=tau)
+    k = K.CORNERS.index("alternating_coactive")
+    swapped = replace(CONTROL, startup=None,
+                      alternating_coactive=root.corner("alternating_coactive"))
+    t = np.arange(0.0, 40.0, DT)
+    a = np.stack([square(t, 0.72, lag, 0.3) for lag in (0.5, 0.0, 0.0, 0.5)], axis=1)
+    late = 30 * tau
+    on = _first_controls(replace(both, restart_v=0.8), a, late)
+    assert np.allclose(on, _first_controls(swapped, a, late), atol=1e-9, rtol=0)
+    assert np.allclose(_first_controls(both, a, late),
+                       _first_controls(replace(both, startup=None), a, late), atol=1e-9, rtol=0)
+    assert not np.allclose(on, _first_controls(both, a, late), atol=1e-3)
+    assert both.startup[k] != CONTROL.corner("alternating_coactive")
+
+
 def test_startup_gains_round_trip_and_refuse_bad_input():
     """A gains file's start-up section reads back as it was written, through the kernel's
     parameter array too; a hand-over time outside (0, 60] s, or a start-up section without

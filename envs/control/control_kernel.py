@@ -26,7 +26,7 @@ from cpgbiped.cpg.feedback import outputs as fb_outputs
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in
 # CORNER order: (sigma, kappa) = (0, 0), (0, 1), (1, 0), (1, 1).
-SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort")
+SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort", "restart_v")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
@@ -34,7 +34,7 @@ BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "k
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0}
-ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0}
+ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0}
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -84,6 +84,9 @@ FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (b
 
 
 FEATURE_PRIOR = 0.3  # mean square activation of a cell that bursts a third of its cycle
+# restart_v's gate: full below a synchrony of 0.7, none above 0.9 (a jump's or hop's rhythm), so
+# that a two-legged gait standing in place never runs on the run corner's start-up gains.
+RESTART_SIGMA_OFF, RESTART_SIGMA_BAND = 0.9, 0.2
 SIGMA_LIFT = 0.4  # a leg lifts on its own only in a rhythm whose legs alternate (sigma below)
 
 
@@ -169,13 +172,24 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         q = N_SHARED + 4 * n
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
     # Start-up gains (when P carries them): the same blend of a second set of corners, which
-    # hands over to the first as exp(-t_s / tau_s) (tau_s the last number of P).
+    # hands over to the first as nu = exp(-t_s / tau_s) (tau_s the last number of P). With
+    # restart_v > 0 the alternating co-activated corner's start-up gains return while the body
+    # is slower than restart_v in an alternating rhythm:
+    #   nu_ac = max(nu, clip((0.9 - sigma) / 0.2, 0, 1) clip(1 - v_com / restart_v, 0, 1)).
     if P.shape[0] == P_SIZE_STARTUP:
         nu = math.exp(-t_s / P[P_SIZE_STARTUP - 1])
         for n in range(len(BLENDED)):
             q = P_SIZE + 4 * n
             G[n] = (1.0 - nu) * G[n] + nu * (w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2]
                                              + w11 * P[q + 3])
+        restart_v = P[6]
+        if restart_v > 0.0:  # (0: the arithmetic above alone, bit for bit as before it)
+            nu_ac = max(nu, _clip01((RESTART_SIGMA_OFF - sigma) / RESTART_SIGMA_BAND)
+                        * _clip01(1.0 - sens[ix[IX_COMVEL]] / restart_v))
+            if nu_ac > nu:  # the alternating co-activated corner's share moves to nu_ac
+                for n in range(len(BLENDED)):
+                    m = N_SHARED + 4 * n + 1
+                    G[n] += w01 * (nu_ac - nu) * (P[P_SIZE + 4 * n + 1] - P[m])
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
      swing_rest, x_clear, push_off, knee_hold, land_yield) = (

@@ -93,7 +93,13 @@ While the features are still near their neutral prior (a quarter of each corner)
 CPG's first cycles pass other corners, the body runs on gains that a later search of one
 corner does not move: without them, a search of the jump's corner changed every walk's first
 steps (README, "Start-up gains"). They change no rhythm: which corner's gains apply is still
-the CPG's features' choice.
+the CPG's features' choice. With restart_v > 0 (m/s; 0 in the committed gains) the alternating
+co-activated corner's (the run's) start-up gains also return whenever the body is slow in an
+alternating rhythm, as after a backward push, through a walk -> run change or into a run from
+standing in place:
+    nu_ac = max(nu, clip((0.9 - sigma) / 0.2, 0, 1) clip(1 - v_com / restart_v, 0, 1)),
+the other corners keeping nu (measured, not adopted: docs/JOURNAL.md, "Measured on
+2026-12-05, not adopted").
 
 What makes the gaits differ is the CPG: left-right extensors in antiphase give alternating
 support (walk, run), in phase both legs push and fly together (jump, hop); synchrony (sigma)
@@ -165,6 +171,8 @@ class ControlParams:
     contact_hold: float  # s: ground contact held this long after the last touch
     lift_abort: float  # > 0.5: a lift ends while its foot is still down if the other foot
     # leaves the ground first (0 reproduces the controller before it)
+    restart_v: float  # m/s: > 0, the alternating co-activated corner's start-up gains return
+    # while the body is slower than this in an alternating rhythm (0: never; see the docstring)
     alternating: Corner  # sigma = 0, kappa = 0 (the walk's rhythm)
     alternating_coactive: Corner  # sigma = 0, kappa = 1 (the run's)
     synchronous: Corner  # sigma = 1, kappa = 0 (the two-legged jump's)
