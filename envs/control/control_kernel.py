@@ -139,6 +139,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     """Write the 8 controls for time t_s (s) into u, from the CPG's activations a (4,)."""
     ankle_gain, e_on, w_flex, w_cross, contact_hold = P[0], P[1], P[2], P[3], P[4]
     lift_abort = P[5] > 0.5
+    restart_v = P[6]  # m/s; 0: off
     # Per leg i (0 left, 1 right): flexor f = a[i], extensor e = a[2 + i].
     e = np.empty(2)
     f = np.empty(2)
@@ -172,17 +173,15 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         q = N_SHARED + 4 * n
         G[n] = w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2] + w11 * P[q + 3]
     # Start-up gains (when P carries them): the same blend of a second set of corners, which
-    # hands over to the first as nu = exp(-t_s / tau_s) (tau_s the last number of P). With
-    # restart_v > 0 the alternating co-activated corner's start-up gains return while the body
-    # is slower than restart_v in an alternating rhythm:
-    #   nu_ac = max(nu, clip((0.9 - sigma) / 0.2, 0, 1) clip(1 - v_com / restart_v, 0, 1)).
+    # hands over to the first as nu = exp(-t_s / tau_s) (tau_s the last number of P); with
+    # restart_v > 0 the alternating co-activated corner's share hands over as nu_ac instead
+    # (the controller's docstring).
     if P.shape[0] == P_SIZE_STARTUP:
         nu = math.exp(-t_s / P[P_SIZE_STARTUP - 1])
         for n in range(len(BLENDED)):
             q = P_SIZE + 4 * n
             G[n] = (1.0 - nu) * G[n] + nu * (w00 * P[q] + w01 * P[q + 1] + w10 * P[q + 2]
                                              + w11 * P[q + 3])
-        restart_v = P[6]
         if restart_v > 0.0:  # (0: the arithmetic above alone, bit for bit as before it)
             nu_ac = max(nu, _clip01((RESTART_SIGMA_OFF - sigma) / RESTART_SIGMA_BAND)
                         * _clip01(1.0 - sens[ix[IX_COMVEL]] / restart_v))
