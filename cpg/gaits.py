@@ -123,3 +123,28 @@ def classify(t: np.ndarray, x: np.ndarray, *, phase_tol_deg: float = 15.0,
 def phase_errors(phases_deg: np.ndarray, gait_name: str) -> np.ndarray:
     """z1..z3: wrapped errors (deg, 0..180) of RF, LE, RE phases vs a primary gait's targets."""
     return wrap_deg(np.asarray(phases_deg)[..., -3:] - gait(gait_name).target_phases_deg)
+
+
+def named_windows(t: np.ndarray, x: np.ndarray, start: float, period: float,
+                  window: int = 4, n: int = 14) -> list[str]:
+    """The classifier's gait over windows of ``window`` periods that start 0, 1, ..., n-1
+    periods after ``start`` (t, start and period in one unit; x: (T, 4) signals in the order
+    LF, RF, LE, RE); "none" for a window past the signals' end. Four periods, not three: the
+    classifier needs three whole cycles between a reference's upcrossings, which a window of
+    three periods holds only when it starts at one."""
+    t = np.asarray(t, float)
+    names = []
+    for k in range(int(n)):
+        lo, hi = start + k * period, start + (k + window) * period
+        w = (t >= lo) & (t < hi)
+        names.append(classify(t[w], np.asarray(x)[w])[0] if t[-1] >= hi - 1e-9 else "none")
+    return names
+
+
+def settled_at(names: list[str], target: str, min_windows: int = 2) -> int | None:
+    """The first index from which every name in ``names`` is ``target`` (at least
+    ``min_windows`` of them), or None."""
+    for i in range(len(names) - int(min_windows) + 1):
+        if all(n == target for n in names[i:]):
+            return i
+    return None

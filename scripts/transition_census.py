@@ -13,7 +13,9 @@ A transition counts as switched as the tests count it: no fall, the physical gai
 change is A, and the settled gait after it is B (``cycles_to_switch`` set; the tests also ask
 for at most 4 CPG cycles, reported here as "within 4"). Seeds 3000 and up are neither tuning
 conditions (1000-1099) nor the tests' (10-19). Prints one row per pair and way: switched,
-within 4 cycles, A named before the change, fell.
+within 4 cycles, A named before the change, fell, and for the open-loop ways, in brackets,
+the states from which the network alone (the same change, no body) is in B's pattern from
+the 4th CPG cycle after the change on: what bounds any body it drives open loop.
 """
 import argparse
 import itertools
@@ -38,10 +40,28 @@ def one(job):
 
     res, *_ = transition("ml", a, b, at, ramp, default_seconds(a, b, at, ramp), K, seed=seed)
     n = res["cycles_to_switch"]
-    return a, b, ramp, K, seed, {
+    net_alone = network_alone(a, b, ramp, seed, at) if K == 0 else None
+    return a, b, ramp, K, seed, {"network_alone_within_4": net_alone,
         "switched": res["switched"], "within_4": bool(res["switched"] and n <= 4),
         "before": res["before"]["physical_gait"], "after": res["after"]["physical_gait"],
         "fell": res["fell"], "cycles_to_switch": n}
+
+
+def network_alone(a: str, b: str, ramp_s: float, seed: int, at_s: float) -> bool:
+    """The open-loop network without a body, the same change from the same state: does the
+    CPG classifier name B in every window of 4 CPG cycles of B from the 4th cycle after the
+    change on (14 windows)? When it does not, no body driven by it open loop can pass the
+    tests' 4 cycles."""
+    from cpgbiped.cpg.gaits import named_windows, settled_at
+    from cpgbiped.cpg.integrate import Schedule
+    from cpgbiped.cpg.network import build
+
+    net, to = build("ml", a, seed=seed), build("ml", b)
+    u, T = net.units_per_s, to.period()
+    at = at_s * u
+    out = net.outputs(at + 19 * T, to=to, schedule=Schedule.change(at, ramp_s * u))
+    k = settled_at(named_windows(out.t_model, out.v, at, T), b)
+    return k is not None and k <= 4
 
 
 def main() -> None:
@@ -61,14 +81,16 @@ def main() -> None:
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
         res = list(ex.map(one, jobs, chunksize=4))
     print(f"transitions at {a.at:g} s from CPG seeds {a.first}-{a.first + a.n - 1} "
-          f"({a.n} states): switched / within 4 CPG cycles / A named before / fell")
+          f"({a.n} states): switched / within 4 CPG cycles / A named before / fell "
+          f"[open loop: the network alone, without a body, in B's pattern from the 4th cycle]")
     for x, y in pairs:
         for r, k in ways:
             rows = [o for (p, q, rr, kk, _, o) in res if (p, q, rr, kk) == (x, y, r, k)]
             print(f"  {x:>4} -> {y:<4} {'step' if r == 0 else f'{r:g} s ramp':>9}, "
                   f"K = {k:<5g}: {sum(o['switched'] for o in rows):2d} / "
                   f"{sum(o['within_4'] for o in rows):2d} / "
-                  f"{sum(o['before'] == x for o in rows):2d} / {sum(o['fell'] for o in rows):2d}")
+                  f"{sum(o['before'] == x for o in rows):2d} / {sum(o['fell'] for o in rows):2d}"
+                  + (f" [{sum(o['network_alone_within_4'] for o in rows):2d}]" if k == 0 else ""))
     if a.json:
         with open(a.json, "w") as f:
             json.dump([{"from": p, "to": q, "ramp_s": r, "K": k, "cpg_seed": s, **o}
