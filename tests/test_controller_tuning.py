@@ -226,7 +226,7 @@ def test_the_worst_condition_weighs_as_told():
 
 
 def test_conditions_can_be_picked_by_number():
-    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-40,
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-48,
     reversed ranges and text are refused."""
     from cpgbiped.envs.search.controller_tuning import condition_ids
 
@@ -237,11 +237,11 @@ def test_conditions_can_be_picked_by_number():
     assert s.conditions() == every[:8] + every[20:24]
     assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
     assert condition_ids("3,3,1") == (3, 1)
-    for bad in ("0-3", "20-41", "5-2", "a", "1-", ""):
+    for bad in ("0-3", "20-49", "5-2", "a", "1-", ""):
         with pytest.raises(InputError):
             condition_ids(bad)
     with pytest.raises(InputError):
-        TuneSettings(("walk",), n_conditions=1, condition_ids=(41,))
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(49,))
     # 25-28: pushes twice the largest of the conditions before them, as many forwards as
     # backwards, each from a CPG state of its own
     big = [c["push"] for c in every[24:28]]
@@ -271,7 +271,50 @@ def test_conditions_can_be_picked_by_number():
         == 11.5
     with pytest.raises(InputError, match="use --seconds 12 or more"):
         TuneSettings(("run",), n_conditions=1, condition_ids=(40,), seconds=11.5)
-    assert len({c["cpg_seed"] for c in every}) == len(every) == MAX_CONDITIONS == 40
+    # 41-48: a transition to the partner in the family, each of the four ways the tests run
+    # (step or 2 s ramp, open loop or the tuning feedback) twice, at 7 and 7.5 s, never at the
+    # tests' 8 s
+    changes = every[40:48]
+    assert all(set(c) <= {"cpg_seed", "change", "feedback"} for c in changes)
+    ways = [(c["change"][1], c.get("feedback", 0.0)) for c in changes]
+    assert sorted(set(ways)) == [(0.0, 0.0), (0.0, 0.01), (2.0, 0.0), (2.0, 0.01)]
+    assert all(ways.count(w) == 2 for w in set(ways))
+    assert sorted({c["change"][0] for c in changes}) == [7.0, 7.5]
+    assert all("change" not in c for c in every[:40])
+    assert len({c["cpg_seed"] for c in every}) == len(every) == MAX_CONDITIONS == 48
+
+
+def test_a_transition_condition_is_the_transition_command_s_rollout_judged_as_the_partner():
+    """Condition 44 (the walk network ramped to the run's over 2 s at 7 s, with the tuning
+    feedback) scores the walk's gains on the rollout that ``cpgbiped transition --from walk
+    --to run --at 7 --ramp 2 --feedback 0.01 --seed 1083`` makes (the same fall, or none), judged
+    as the run from 4 run periods after the change began, for 5 s; its cost is the run's
+    rollout cost over that window (envs.experiments.transition, computed independently)."""
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.control.controller import params_array
+    from cpgbiped.envs.experiments.transition import transition
+    from cpgbiped.envs.search.controller_tuning import ControllerTuningProblem, condition_trial
+    from cpgbiped.envs.simulation.trials import run_control_trial
+
+    c = tuning_conditions(MAX_CONDITIONS)[43]
+    assert c["change"] == (7.0, 2.0) and c["feedback"] == 0.01
+    P = tuple(params_array(read_gains()[0]).tolist())
+    trial = condition_trial("walk", P, c)
+    assert (trial.preset, trial.to, trial.change) == ("walk", "run", (7.0, 2.0))
+    s = run_control_trial(trial, 6.0)  # the window asked for does not apply to a transition
+    T = build("ml", "run").period_s()
+    assert s["judge"] == {"gait": "run", "from_s": pytest.approx(7.0 + 4 * T), "seconds": 5.0}
+    assert s["total_s"] == pytest.approx(7.0 + 4 * T + 5.0)
+    res, *_ = transition("ml", "walk", "run", 7.0, 2.0, s["total_s"], feedback=0.01,
+                         seed=c["cpg_seed"])
+    assert s["fell"] == res["fell"]
+    if res["fell"]:
+        assert s["survived_s"] == pytest.approx(res["fell_at_s"])
+    settings = TuneSettings(("walk",), n_conditions=1, condition_ids=(44,))
+    problem = ControllerTuningProblem(settings, read_gains()[0])
+    want = rollout_cost("run", s, 5.0, settle_s=7.0 + 4 * T)
+    assert problem.gait_costs([s])[0, 0] == pytest.approx(want)
+    assert want != pytest.approx(rollout_cost("walk", s, 6.0))
 
 
 def test_the_start_up_gains_are_searched_when_named():

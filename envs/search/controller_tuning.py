@@ -19,7 +19,8 @@ some with another floor friction or a horizontal push on the torso; from the nin
 walk driven by another walk network or the loop closed
 (:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's;
 the twenty-first to fortieth: transient CPG states, bigger pushes, slippery floors and pushes
-of a settled gait (:func:`tuning_conditions`).
+of a settled gait; the forty-first to forty-eighth: a transition to the gait's partner in its
+family (walk <-> run, jump <-> hop) in mid-run, judged as the partner (:func:`tuning_conditions`).
 The tests and the README report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
@@ -140,7 +141,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 40
+MAX_CONDITIONS = 48
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 # CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
 # starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
@@ -167,6 +168,18 @@ SLIPPERY = tuple((1052 + k, 0.4) for k in range(4)) + tuple((1056 + k, 0.6) for 
 HELD_PUSH_MARGIN_S = 1.0  # a held push's condition needs this long after the push ends
 SETTLED_PUSHES = ((1060, (12.3, 5.0, 0.2)), (1061, (12.3, -5.0, 0.2)),
                   (1062, (12.8, 5.0, 0.2)), (1063, (12.8, -5.0, 0.2)))
+# Conditions 41-48: a transition within the gait's family (issue 22): at 7 s (41-44) or 7.5 s
+# (45-48) the network's parameters move to the partner preset's (PARTNER: walk <-> run, jump
+# <-> hop), a step or a 2 s ramp, open loop or with TUNING_FEEDBACK, from CPG seeds 1080-1087,
+# never a test's (the tests change at 8 s from the Table 3 state; the census from seeds 3000
+# and up). The rollout is judged as the partner from 4 of its CPG cycles after the change began
+# (envs.simulation.trials.SWITCH_CYCLES) for 5 s: the survival, progress and criteria terms of
+# the partner, so that a transition that falls, or reaches the partner late, costs.
+PARTNER = {"walk": "run", "run": "walk", "jump": "hop", "hop": "jump"}
+TRANSITIONS = tuple((1080 + 4 * j + i, (at, ramp), k)
+                    for j, at in enumerate((7.0, 7.5))
+                    for i, (ramp, k) in enumerate(((0.0, 0.0), (0.0, 1.0), (2.0, 0.0),
+                                                   (2.0, 1.0))))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -218,7 +231,9 @@ def tuning_conditions(n: int) -> list[dict]:
     torso by 8 N s (:data:`BIG_PUSHES`), the twenty-ninth to thirty-second stand on a floor of
     friction x0.4 and the thirty-third to thirty-sixth on x0.6 (:data:`SLIPPERY`), the
     thirty-seventh to fortieth push a settled gait, 5 N s held 0.2 s at 12.3 and 12.8 s
-    (:data:`SETTLED_PUSHES`); pick them with :attr:`TuneSettings.condition_ids`
+    (:data:`SETTLED_PUSHES`), the forty-first to forty-eighth change the network to the
+    gait's partner in its family mid-run (``change``: (at s, ramp s), :data:`TRANSITIONS`,
+    judged as the partner); pick them with :attr:`TuneSettings.condition_ids`
     (``--conditions 1-8,21-24``)."""
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
@@ -241,7 +256,9 @@ def tuning_conditions(n: int) -> list[dict]:
     out += [{"cpg_seed": s} for s in TRANSIENT_SEEDS[:max(0, int(n) - 20)]]
     out += [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
     out += [{"cpg_seed": s, "friction_scale": f} for s, f in SLIPPERY[:max(0, int(n) - 28)]]
-    return out + [{"cpg_seed": s, "push": p} for s, p in SETTLED_PUSHES[:max(0, int(n) - 36)]]
+    out += [{"cpg_seed": s, "push": p} for s, p in SETTLED_PUSHES[:max(0, int(n) - 36)]]
+    return out + [{"cpg_seed": s, "change": c, **({"feedback": k_fb} if k else {})}
+                  for s, c, k in TRANSITIONS[:max(0, int(n) - 40)]]
 
 
 def condition_ids(text: str) -> tuple[int, ...]:
@@ -268,7 +285,9 @@ def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
     """The rollout of ``gait``'s preset under one tuning condition (its own network's weights
     when the condition names some for it)."""
     w = cond.get("weights", {}).get(gait)
+    change = cond.get("change")
     return ControlTrial(gait, control, cpg_seed=cond["cpg_seed"],
+                        to=None if change is None else PARTNER[gait], change=change,
                         friction_scale=cond.get("friction_scale", 1.0), push=cond.get("push"),
                         weights=None if w is None else tuple(w),
                         feedback=cond.get("feedback", 0.0), network=cond.get("network", "ml"),
@@ -532,11 +551,17 @@ class ControllerTuningProblem(Problem):
         """(n_conditions, n_gaits) rollout costs of one point's results (condition-major)."""
         n_g, n_c = len(self.settings.gaits), len(self.conditions)
         only = self.settings.survival_mask()
-        return np.array([[rollout_cost(g, results[c * n_g + j], self.settings.seconds,
-                                       shortfall=self.settings.shortfall_weight,
-                                       survival_only=bool(only[c]),
-                                       target_froude=self.settings.froude_target(g),
-                                       progress=self.settings.progress_weight)
+        def cost(g: str, r: dict, survival_only: bool) -> float:
+            judge = r.get("judge")  # a transition: judged as its target over its own window
+            g, seconds, settle_s = ((judge["gait"], judge["seconds"], judge["from_s"]) if judge
+                                    else (g, self.settings.seconds, SETTLE_S))
+            return rollout_cost(g, r, seconds, settle_s=settle_s,
+                                shortfall=self.settings.shortfall_weight,
+                                survival_only=survival_only,
+                                target_froude=self.settings.froude_target(g),
+                                progress=self.settings.progress_weight)
+
+        return np.array([[cost(g, results[c * n_g + j], bool(only[c]))
                           for j, g in enumerate(self.settings.gaits)] for c in range(n_c)])
 
     def reference_costs(self) -> np.ndarray:
@@ -735,7 +760,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
               problem.history)
     head = ["gait", "network", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost",
             "fell", "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
-            "apex_height_m", "stride_cv", "ankle_excursion_deg", "fell_at_s_horizon"]
+            "apex_height_m", "stride_cv", "ankle_excursion_deg", "fell_at_s_horizon",
+            "to", "change_at_s", "change_ramp_s"]  # a transition (41-48): judged as "to"
     rows = []
     n_g = len(settings.gaits)
     best_costs = problem.gait_costs(summaries[k])
@@ -751,7 +777,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                          _r(s["duty_factor"]["left"]), _r(s["duty_factor"]["right"]),
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
                          _r(s["ankle_excursion_deg"]),
-                         "" if late[c * n_g + j] is None else late[c * n_g + j]])
+                         "" if late[c * n_g + j] is None else late[c * n_g + j],
+                         *((PARTNER[g], *cond["change"]) if "change" in cond else ("", "", ""))])
     write_csv(rd.path("tune_conditions.csv"), head, rows)
     return {"gains": gains, "entry": entry, "best": summaries[k], "params": tuned}
 

@@ -132,7 +132,9 @@ class ControlTrial:
     the body's feedback into the CPG (0: open loop) and ``feedback_form`` its Morris-Lecar
     pathway (None: the recommended one, ``cpg.feedback.CHOICE``); ``network`` the kind of
     network whose preset drives the body (``cpg.network.KINDS``; weights are Morris-Lecar's
-    only)."""
+    only). ``to`` and ``change`` (at s, ramp s) make it a transition: at ``at`` the network's
+    parameters move to preset ``to``'s, as a step (ramp 0) or a linear ramp, and the rollout is
+    judged as ``to`` (:func:`run_control_trial`)."""
 
     preset: str
     control: tuple
@@ -143,13 +145,26 @@ class ControlTrial:
     feedback: float = 0.0
     network: str = "ml"
     feedback_form: str | None = None
+    to: str | None = None
+    change: tuple[float, float] | None = None
+
+
+SWITCH_CYCLES = 4  # a transition is judged from this many CPG cycles of the target after the
+# change began (issue 22: the physical gait B within 4 CPG cycles of the change)
+JUDGE_S = 5.0  # s of a transition's rollout judged as the target, from there
 
 
 def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SETTLE_S,
                       stop_on_fall: bool = True) -> dict:
     """Roll ``trial`` out and return its summary (:meth:`envs.validate.Validation.summary`,
     the gait named by ``preset``) plus ``survived_s`` (simulated seconds before a fall, the
-    whole rollout otherwise), ``total_s`` and ``cpg_period_s``."""
+    whole rollout otherwise), ``total_s`` and ``cpg_period_s``.
+
+    A transition (``trial.to``) ignores ``seconds`` and ``settle_s``: its rollout lasts until
+    SWITCH_CYCLES CPG cycles of the target after the change began plus JUDGE_S, and its
+    summary, of that last JUDGE_S against the target's criteria, carries ``judge``: {"gait":
+    the target, "from_s": where the judged window starts, "seconds": JUDGE_S}."""
+    from cpgbiped.cpg.integrate import Schedule
     from cpgbiped.cpg.network import build
 
     from cpgbiped.envs.control.controller import params_from_array
@@ -159,11 +174,20 @@ def run_control_trial(trial: ControlTrial, seconds: float, settle_s: float = SET
     total = settle_s + seconds
     net = build(trial.network, trial.preset, seed=trial.cpg_seed,
                 weights=None if trial.weights is None else list(trial.weights))
+    judged, change = net, {}
+    if trial.to is not None:
+        at_s, ramp_s = trial.change
+        judged = build(trial.network, trial.to)
+        settle_s = at_s + SWITCH_CYCLES * judged.period_s()
+        total = settle_s + JUDGE_S
+        change = {"to": judged, "change": Schedule.change(at_s, ramp_s)}
     rec = rollout(net, total, params_from_array(np.asarray(trial.control, float)),
                   friction_scale=trial.friction_scale, push=trial.push,
                   stop_on_fall=stop_on_fall, poses=False, feedback=trial.feedback,
-                  feedback_form=trial.feedback_form)
-    s = measure_recording(net, trial.preset, rec, settle_s).summary()
+                  feedback_form=trial.feedback_form, **change)
+    s = measure_recording(judged, trial.to or trial.preset, rec, settle_s).summary()
+    if trial.to is not None:
+        s["judge"] = {"gait": trial.to, "from_s": settle_s, "seconds": JUDGE_S}
     fell = bool(s["fell"]) or rec.unstable is not None
     s["fell"] = fell
     s["survived_s"] = (float(rec.t[-1]) if len(rec.t) else 0.0) if fell else total
