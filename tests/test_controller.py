@@ -251,7 +251,8 @@ def test_startup_gains_hand_over_to_the_corners():
 def test_restart_v_returns_the_run_corner_s_start_up_gains_to_a_slow_body():
     """restart_v (m/s; 0 in the committed gains): in an alternating rhythm the alternating
     co-activated corner's start-up gains return while the body is slower than restart_v,
-    nu_ac = max(nu, clip((0.9 - sigma) / 0.2) clip(1 - v / restart_v)). On the lifted body at
+    nu_ac = max(nu, clip((0.9 - sigma) / 0.2) clip(1 - <v> / restart_v)), <v> its speed's
+    running average (test below). On the lifted body at
     rest (v = 0) with the features at their prior (sigma = 0.5: the gate is open), 30 tau_s
     after the start, the controls equal those of gains whose run corner is replaced by its
     start-up corner and no restart (an independent parameter set, to 1e-9); at restart_v = 0
@@ -276,6 +277,24 @@ def test_restart_v_returns_the_run_corner_s_start_up_gains_to_a_slow_body():
                        _first_controls(replace(both, startup=None), a, late), atol=1e-9, rtol=0)
     assert not np.allclose(on, _first_controls(both, a, late), atol=1e-3)
     assert both.startup[k] != CONTROL.corner("alternating_coactive")
+
+
+def test_the_restart_reads_the_body_s_speed_averaged_over_the_features_time_constant():
+    """restart_v compares with the centre of mass's forward speed averaged as the CPG features
+    are (time constant TAU_FEATURE), not with the speed of one tick, which dips at every
+    landing: the body held moving at 1 m/s (its root's velocity, no stepping) for 1 s of
+    controller calls every 2 ms reads 1 - exp(-1 s / TAU_FEATURE), the closed form of the
+    running average started at 0."""
+    m, d = lifted_body()
+    d.qvel[m.jnt_dofadr[m.joint("rootx").id]] = 1.0
+    mujoco.mj_forward(m, d)
+    t = np.arange(0.0, 2.0, DT)
+    a = np.stack([square(t, 0.72, lag, 0.3) for lag in (0.5, 0.0, 0.0, 0.5)], axis=1)
+    ctl = CPGController(m, d, synthetic(a), params=CONTROL)
+    for t_s in np.arange(0, 501) * DT:  # the first call only starts the clock
+        ctl(float(t_s))
+    want = 1.0 - np.exp(-1.0 / K.TAU_FEATURE)
+    assert ctl.S[K.S_SPEED] == pytest.approx(want, rel=1e-3), (ctl.S[K.S_SPEED], want)
 
 
 def test_startup_gains_round_trip_and_refuse_bad_input():

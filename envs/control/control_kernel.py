@@ -59,7 +59,8 @@ S_AIRBORNE, S_SWING_DONE = 21, 23  # pairs: the swinging foot has left the groun
 # S_YIELD, pair: the landing's yield (0: none; 1: armed, the leg is off the ground or has just
 # landed; 2: landed and its knee is flexing). Cleared when the knee's flexion stops.
 S_YIELD = 25
-S_SIZE = 27
+S_SPEED = 27  # the centre of mass's forward speed (m/s), a running average (TAU_FEATURE)
+S_SIZE = 28
 TAU_FEATURE = 0.5  # s: time constant of those running averages
 # Leg modes (S_MODE), for recordings and tests.
 MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
@@ -158,6 +159,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         S[S_C_FE] += w * (f[0] * e[0] + f[1] * e[1] - S[S_C_FE])
         S[S_V_F] += w * (f[0] * f[0] + f[1] * f[1] - S[S_V_F])
         S[S_V_E] += w * (e[0] * e[0] + e[1] * e[1] - S[S_V_E])
+        S[S_SPEED] += w * (sens[ix[IX_COMVEL]] - S[S_SPEED])
     S[S_LAST_T] = t_s
     sigma = _clip01(S[S_C_LR] / (math.sqrt(S[S_V_L] * S[S_V_R]) + 1e-3))
     kappa = _clip01(S[S_C_FE] / (math.sqrt(S[S_V_F] * S[S_V_E]) + 1e-3))
@@ -184,7 +186,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                                              + w11 * P[q + 3])
         if restart_v > 0.0:  # (0: the arithmetic above alone, bit for bit as before it)
             nu_ac = max(nu, _clip01((RESTART_SIGMA_OFF - sigma) / RESTART_SIGMA_BAND)
-                        * _clip01(1.0 - sens[ix[IX_COMVEL]] / restart_v))
+                        * _clip01(1.0 - S[S_SPEED] / restart_v))
             if nu_ac > nu:  # the alternating co-activated corner's share moves to nu_ac
                 for n in range(len(BLENDED)):
                     m = N_SHARED + 4 * n + 1
