@@ -216,11 +216,15 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     assert give[0.0] < 0.02 and give[1.0] > 2.0 * give[0.0], give
 
 
-def _first_controls(params, a, t_s):
+def _first_controls(params, a, t_s, sigma0=False):
     """The controls of a fresh controller's first call at t_s (s) on the lifted body: the
-    features are still their prior, so only the gains differ between parameter sets."""
+    features are still their prior (sigma0: the extensors' synchrony set to 0 instead), so
+    only the gains differ between parameter sets."""
     m, d = lifted_body()
-    return CPGController(m, d, synthetic(a), params=params)(t_s).copy()
+    ctl = CPGController(m, d, synthetic(a), params=params)
+    if sigma0:
+        ctl.S[K.S_C_LR] = 0.0
+    return ctl(t_s).copy()
 
 
 def test_startup_gains_hand_over_to_the_corners():
@@ -251,12 +255,13 @@ def test_startup_gains_hand_over_to_the_corners():
 def test_restart_v_returns_the_run_corner_s_start_up_gains_to_a_slow_body():
     """restart_v (m/s; 0 in the committed gains): in an alternating rhythm the alternating
     co-activated corner's start-up gains return while the body is slower than restart_v,
-    nu_ac = max(nu, clip((0.9 - sigma) / 0.2) clip(1 - <v> / restart_v)), <v> its speed's
-    running average (test below). On the lifted body at
-    rest (v = 0) with the features at their prior (sigma = 0.5: the gate is open), 30 tau_s
-    after the start, the controls equal those of gains whose run corner is replaced by its
-    start-up corner and no restart (an independent parameter set, to 1e-9); at restart_v = 0
-    they are the corners' own, and the two differ, so the test can fail."""
+    nu_ac = max(nu, clip((SIGMA_LIFT - sigma) / 0.2) clip(1 - <v> / restart_v)), <v> its
+    speed's running average (test below). On the lifted body at rest (v = 0) with the
+    extensors' synchrony set to 0 (the gate open; kappa at its prior, 0.5), 30 tau_s after the
+    start, the controls equal those of gains whose run corner is replaced by its start-up
+    corner and no restart (an independent parameter set, to 1e-9); at restart_v = 0 they are
+    the corners' own, and the two differ, so the test can fail. At the prior's synchrony, 0.5,
+    above SIGMA_LIFT, the gate is shut and restart_v changes nothing."""
     from dataclasses import replace
 
     from cpgbiped.envs.control.controller import read_gains
@@ -271,12 +276,15 @@ def test_restart_v_returns_the_run_corner_s_start_up_gains_to_a_slow_body():
     t = np.arange(0.0, 40.0, DT)
     a = np.stack([square(t, 0.72, lag, 0.3) for lag in (0.5, 0.0, 0.0, 0.5)], axis=1)
     late = 30 * tau
-    on = _first_controls(replace(both, restart_v=0.8), a, late)
-    assert np.allclose(on, _first_controls(swapped, a, late), atol=1e-9, rtol=0)
-    assert np.allclose(_first_controls(both, a, late),
-                       _first_controls(replace(both, startup=None), a, late), atol=1e-9, rtol=0)
-    assert not np.allclose(on, _first_controls(both, a, late), atol=1e-3)
+    on = _first_controls(replace(both, restart_v=0.8), a, late, sigma0=True)
+    assert np.allclose(on, _first_controls(swapped, a, late, sigma0=True), atol=1e-9, rtol=0)
+    assert np.allclose(_first_controls(both, a, late, sigma0=True),
+                       _first_controls(replace(both, startup=None), a, late, sigma0=True),
+                       atol=1e-9, rtol=0)
+    assert not np.allclose(on, _first_controls(both, a, late, sigma0=True), atol=1e-3)
     assert both.startup[k] != CONTROL.corner("alternating_coactive")
+    assert np.allclose(_first_controls(replace(both, restart_v=0.8), a, late),
+                       _first_controls(both, a, late), atol=1e-12, rtol=0)
 
 
 def test_the_restart_reads_the_body_s_speed_averaged_over_the_features_time_constant():

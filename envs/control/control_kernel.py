@@ -85,10 +85,11 @@ FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (b
 
 
 FEATURE_PRIOR = 0.3  # mean square activation of a cell that bursts a third of its cycle
-# restart_v's gate: full below a synchrony of 0.7, none above 0.9 (a jump's or hop's rhythm), so
-# that a two-legged gait standing in place never runs on the run corner's start-up gains.
-RESTART_SIGMA_OFF, RESTART_SIGMA_BAND = 0.9, 0.2
 SIGMA_LIFT = 0.4  # a leg lifts on its own only in a rhythm whose legs alternate (sigma below)
+# restart_v's gate: full below a synchrony of 0.2, none from SIGMA_LIFT on, the controller's own
+# bound of an alternating rhythm, so that a rhythm whose legs push together (a jump's, a hop's,
+# a network passing through one) never runs on the run corner's start-up gains.
+RESTART_SIGMA_OFF, RESTART_SIGMA_BAND = SIGMA_LIFT, 0.2
 
 
 def new_state() -> np.ndarray:

@@ -97,7 +97,8 @@ the CPG's features' choice. With restart_v > 0 (m/s; 0 in the committed gains) t
 co-activated corner's (the run's) start-up gains also return whenever the body is slow in an
 alternating rhythm, as after a backward push, through a walk -> run change or into a run from
 standing in place:
-    nu_ac = max(nu, clip((0.9 - sigma) / 0.2, 0, 1) clip(1 - <v_com> / restart_v, 0, 1)),
+    nu_ac = max(nu, clip((0.4 - sigma) / 0.2, 0, 1) clip(1 - <v_com> / restart_v, 0, 1)),
+0.4 the synchrony below which the controller counts the legs as alternating (SIGMA_LIFT),
 <v_com> the centre of mass's forward speed averaged as the features are (time constant 0.5 s;
 the speed of one tick dips at every landing, and a run that braked for one landing would get
 its start-up push back), the other corners keeping nu (measured, not adopted: docs/JOURNAL.md, "Measured on
