@@ -257,6 +257,28 @@ def test_the_default_rollout_across_the_families_covers_the_network_s_lock_time(
     assert default_seconds("walk", "run", 8.0, 2.0) < default_seconds("walk", "hop", 8.0, 2.0)
 
 
+def test_the_transition_says_what_the_network_alone_does():
+    """The result's network_alone: the same change without a body. From the run to the walk
+    the network is still in the hop's pattern 4 cycles after the change, from the jump to the
+    hop it is a hop by then; checked against the CPG classifier on the controller's own
+    integration of the network (cpg_schedule, another sampling of the same equations) over the
+    window of 4 cycles that starts 4 cycles after the change."""
+    from cpgbiped.cpg.gaits import classify
+    from cpgbiped.envs.control.controller import cpg_schedule
+
+    for a, b, want in (("run", "walk", "hop"), ("jump", "hop", "hop")):
+        res, *_ = transition("ml", a, b, 8.0, 0.0, 12.0)
+        na = res["network_alone"]
+        net, to = build("ml", a), build("ml", b)
+        T = to.period_s()
+        s = cpg_schedule(net, 8.0 + 9 * T, to=to, change=Schedule.change(8.0, 0.0))
+        t = np.arange(len(s.v)) * s.dt_s
+        w = (t >= 8.0 + 4 * T) & (t < 8.0 + 8 * T)
+        assert classify(t[w], s.v[w])[0] == want == na["windows"][4], (a, b, na)
+        within = na["cycles_to_switch"] is not None and na["cycles_to_switch"] <= 4
+        assert within == (want == b), na
+
+
 def test_extensor_synchrony_is_zero_for_alternating_and_one_for_in_phase_bursts():
     """On square bursts made here: the legs' extensors half a cycle apart share no time; in
     phase they share all of it; a quarter cycle apart, a third of the time either bursts

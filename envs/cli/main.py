@@ -901,6 +901,10 @@ def cmd_transition(a) -> int:
         print(f"  fell: {'at %.2f s' % res['fell_at_s'] if res['fell'] else 'no'}; switched to "
               f"{dst}: " + (f"after {res['cycles_to_switch']} CPG cycles"
                             if res["cycles_to_switch"] is not None else "no"))
+        na = res["network_alone"]["cycles_to_switch"]
+        print(f"  the network alone (the same change, no body, open loop): {dst}'s pattern "
+              + (f"from {na} CPG cycles after the change" if na is not None else
+                 f"not within {len(res['network_alone']['windows'])} CPG cycles"))
         if written:
             print("wrote " + ", ".join(written))
     return 0

@@ -30,6 +30,14 @@ the change, the share of the time in which either leg's extensor activation is a
 alternate (a walk's or a run's network), 1 when they are in phase (a jump's or a hop's). A
 body cannot walk within a few cycles of a change while its network drives both legs' stances
 together.
+
+``network_alone``: the same change of the same network from the same state, integrated open
+loop without a body, named by the CPG classifier over windows of NETWORK_WINDOW_CYCLES CPG
+cycles of B that start 0, 1, ... cycles after the change (``cpg.gaits.named_windows``);
+``cycles_to_switch`` there is the first window from which every later one names B (None: not
+within NETWORK_WINDOWS). When it is above 4, no body driven open loop can pass issue 22's test
+(README, "What the network alone allows"); with feedback it is the reference the coupled
+system is compared with.
 """
 from __future__ import annotations
 
@@ -56,6 +64,8 @@ BEFORE_CYCLES = 5  # whole CPG cycles of A before the change (the CPG classifier
 # cycles between its reference's upcrossings; 4 left the jump's unnamed)
 SYNC_CYCLES = 8  # CPG cycles of the target after the change with an extensor synchrony
 E_ON = CONTROL.e_on  # extensor activation of the controller's stance command
+NETWORK_WINDOW_CYCLES = 4  # the CPG classifier needs 3 whole cycles between upcrossings
+NETWORK_WINDOWS = 14  # windows of the network alone after the change
 KEYS = ("physical_gait", "cpg_gait", "fell", "duty_factor", "lr_phase_lag", "double_support",
         "flight", "stride_period_s", "speed_mps", "froude", "apex_height_m")
 
@@ -124,6 +134,21 @@ def extensor_synchrony(t_s, activation, at_s: float, period_s: float,
     return out
 
 
+def network_alone(kind: str, a: str, b: str, at_s: float, ramp_s: float,
+                  seed: int | None = None) -> dict:
+    """The change without a body (see the module docstring): {"windows": the CPG classifier's
+    name per window, "cycles_to_switch": first window from which all later name B, or None}."""
+    from cpgbiped.cpg.gaits import named_windows, settled_at
+
+    net, to = build(kind, a, seed=seed), build(kind, b)
+    u, T = net.units_per_s, to.period()
+    at = at_s * u
+    out = net.outputs(at + (NETWORK_WINDOWS + NETWORK_WINDOW_CYCLES + 1) * T, to=to,
+                      schedule=Schedule.change(at, ramp_s * u))
+    names = named_windows(out.t_model, out.v, at, T, NETWORK_WINDOW_CYCLES, NETWORK_WINDOWS)
+    return {"windows": names, "cycles_to_switch": settled_at(names, b)}
+
+
 def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0,
                seconds: float = 20.0, feedback: float = 0.0, poses: bool = False,
                seed: int | None = None):
@@ -166,7 +191,8 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
                                 and fell_at is None else None),
            "windows": [{"start_s": w["start_s"], "physical_gait": w["physical_gait"]}
                        for w in slides],
-           "cpg_extensor_synchrony": extensor_synchrony(rec.t, rec.drive, at_s, T)}
+           "cpg_extensor_synchrony": extensor_synchrony(rec.t, rec.drive, at_s, T),
+           "network_alone": network_alone(kind, a, b, at_s, ramp_s, seed)}
     res["switched"] = bool(res["cycles_to_switch"] is not None
                            and before["physical_gait"] == a and not res["fell"])
     return res, rec, net, to
