@@ -101,8 +101,8 @@ standing in place:
 0.4 the synchrony below which the controller counts the legs as alternating (SIGMA_LIFT),
 <v_com> the centre of mass's forward speed averaged as the features are (time constant 0.5 s;
 the speed of one tick dips at every landing, and a run that braked for one landing would get
-its start-up push back), the other corners keeping nu (measured, not adopted: docs/JOURNAL.md, "Measured on
-2026-12-05, not adopted").
+its start-up push back), the other corners keeping nu (measured, not adopted:
+docs/JOURNAL.md, "Measured on 2026-12-05, not adopted").
 
 What makes the gaits differ is the CPG: left-right extensors in antiphase give alternating
 support (walk, run), in phase both legs push and fly together (jump, hop); synchrony (sigma)
