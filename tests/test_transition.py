@@ -325,7 +325,8 @@ def test_from_the_run_to_the_walk_the_open_loop_network_hops_and_feedback_undoes
 # The Hopf network's in-family transitions, open loop (its closed loop refuses a parameter
 # change), at the same 8 s protocol; measured shortfalls of the ones that do not pass.
 HOPF_SHORTFALL = {
-    ("walk", "run", 0.0): "a run 9 CPG cycles after the change (4 asked), no fall",
+    ("walk", "run", 0.0): "a run 9 CPG cycles after the change (4 asked), no fall; the "
+                          "Hopf network alone is a run from the 8th",
     ("walk", "run", 2.0): "falls at 10.2 s, as the ramp ends (since the walk's stance knee; "
                           "a run after 2 cycles before)",
     ("run", "walk", 0.0): "falls at 8.6 s, 0.6 s after the change; the network's bursts "
