@@ -46,6 +46,7 @@ from dataclasses import replace
 import numpy as np
 
 from cpgbiped.cpg.errors import InputError
+from cpgbiped.cpg.gaits import named_windows, settled_at
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import PRESETS, build
 
@@ -138,8 +139,6 @@ def network_alone(kind: str, a: str, b: str, at_s: float, ramp_s: float,
                   seed: int | None = None) -> dict:
     """The change without a body (see the module docstring): {"windows": the CPG classifier's
     name per window, "cycles_to_switch": first window from which all later name B, or None}."""
-    from cpgbiped.cpg.gaits import named_windows, settled_at
-
     net, to = build(kind, a, seed=seed), build(kind, b)
     u, T = net.units_per_s, to.period()
     at = at_s * u
@@ -171,12 +170,8 @@ def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0
         t0 = at_s + k * T
         slides.append(window_summary(to, rec, t0, t0 + WINDOW_CYCLES * T, fell_at))
         k += 1
-    settled = None
     names = [w["physical_gait"] for w in slides]
-    for i in range(len(names)):
-        if len(names) - i >= 2 and all(n == names[i] for n in names[i:]):
-            settled = i
-            break
+    settled = settled_at(names, names[-1]) if names else None  # whatever gait it settles in
     start = at_s + (settled if settled is not None else len(slides)) * T
     after = window_summary(to, rec, min(start, float(rec.t[-1]) - T), None, fell_at)
     res = {"network": kind, "from": a, "to": b, "cpg_seed": seed, "at_s": float(at_s),

@@ -99,6 +99,7 @@ from cpgbiped.cpg.errors import InputError
 from cpgbiped.envs.control import control_kernel as kernel
 from cpgbiped.envs.control.controller import (GAINS_FILE, GAINS_FORMAT, ControlParams, params_array,
                          params_from_array, params_from_dict, params_to_dict, read_gains)
+from cpgbiped.envs.experiments.transition import IN_FAMILY
 from cpgbiped.envs.gaits.criteria import CRITERIA, SETTLE_S
 from cpgbiped.envs.simulation.trials import ControlTrial
 
@@ -175,11 +176,11 @@ SETTLED_PUSHES = ((1060, (12.3, 5.0, 0.2)), (1061, (12.3, -5.0, 0.2)),
 # and up). The rollout is judged as the partner from 4 of its CPG cycles after the change began
 # (envs.simulation.trials.SWITCH_CYCLES) for 5 s: the survival, progress and criteria terms of
 # the partner, so that a transition that falls, or reaches the partner late, costs.
-PARTNER = {"walk": "run", "run": "walk", "jump": "hop", "hop": "jump"}
-TRANSITIONS = tuple((1080 + 4 * j + i, (at, ramp), k)
+PARTNER = dict(IN_FAMILY)  # each gait's partner in its family
+TRANSITIONS = tuple((1080 + 4 * j + i, (at, ramp), closed)  # (CPG seed, change, feedback on)
                     for j, at in enumerate((7.0, 7.5))
-                    for i, (ramp, k) in enumerate(((0.0, 0.0), (0.0, 1.0), (2.0, 0.0),
-                                                   (2.0, 1.0))))
+                    for i, (ramp, closed) in enumerate(((0.0, False), (0.0, True), (2.0, False),
+                                                        (2.0, True))))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -257,8 +258,8 @@ def tuning_conditions(n: int) -> list[dict]:
     out += [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
     out += [{"cpg_seed": s, "friction_scale": f} for s, f in SLIPPERY[:max(0, int(n) - 28)]]
     out += [{"cpg_seed": s, "push": p} for s, p in SETTLED_PUSHES[:max(0, int(n) - 36)]]
-    return out + [{"cpg_seed": s, "change": c, **({"feedback": k_fb} if k else {})}
-                  for s, c, k in TRANSITIONS[:max(0, int(n) - 40)]]
+    return out + [{"cpg_seed": s, "change": c, **({"feedback": k_fb} if closed else {})}
+                  for s, c, closed in TRANSITIONS[:max(0, int(n) - 40)]]
 
 
 def condition_ids(text: str) -> tuple[int, ...]:
