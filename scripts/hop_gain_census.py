@@ -24,7 +24,6 @@ apex with the mean speed over the standing draws. About 3.5 minutes per 3000 dra
 from __future__ import annotations
 
 import argparse
-import copy
 import json
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -60,14 +59,12 @@ def one(job):
     import numba
     numba.set_num_threads(1)
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import params_from_dict
+    from cpgbiped.envs.control.controller import CONTROL
     from cpgbiped.envs.gaits.criteria import SETTLE_S
     from cpgbiped.envs.gaits.validate import measure_recording
     from cpgbiped.envs.simulation.rollout import rollout
 
-    d = json.loads((ROOT / "envs/control/gains.json").read_text())
-    d["corners"]["synchronous_coactive"].update(gains)
-    params = params_from_dict(d)
+    params = CONTROL.with_corner("synchronous_coactive", **gains)
     rows = []
     for s in SEEDS:
         net = build("ml", "hop", seed=s)
