@@ -63,18 +63,17 @@ def others_for(gait: str, cond: dict) -> dict:
 _HOP = "apex 1.6-1.9 cm below 4 cm; drifts back at 0.07 m/s (limit 0.05)"
 
 KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
-    # since the hop corner's foot placement (2026-12-05, scripts/hop_placement.py): walk and
-    # run pass in all 13; the jump falls at friction x1.3 (from CPG seed 10 at 7.5 s between
-    # the walk's stance knee and it; at friction x1.3 at 7.7 s after wp1, wp2)
-    "jump-friction1.3": ("falls at 8.4 s", False),
+    # since the jump corner's balance reference (2026-12-05, scripts/jump_balance_reference.py):
+    # walk, run and jump pass in all 13 (before it the jump fell at friction x1.3 at 8.4 s)
     **{f"hop-{cid}": (_HOP, True) for cid in CONDITION_IDS},
 
-    # perturbations (non-strict: a fall or a name at a threshold's edge is chaotic)
-    "run-friction0.5": ("falls at 1.5 s", False),
-    "run-blow-5": ("falls at 7.5 s", False),
-    "jump-friction0.5": ("named a hop (the ankle 28.6 deg in stance, below the 30 deg split; "
-                         "apex 5.5 cm), -0.049 m/s; fell at 4.4 s after wp1, wp2", False),
-    "jump-friction2.0": ("falls at 4.7 s", False),
+    # perturbations (non-strict: a fall or a name at a threshold's edge is chaotic). Since the
+    # jump corner's balance reference the jump keeps its gait on friction x0.5 and x2.0 (named
+    # a hop and falling at 4.7 s before it) and the run on x0.5 (falling at 1.5 s before it)
+    "run-friction2.0": ("falls at 2.5 s, in the start-up", False),
+    "run-blow-5": ("falls at 7.7 s", False),
+    "jump-push+5": ("falls at 7.3 s: pushed forwards in its flexor burst, it takes off from its "
+                    "toes and runs away forwards", False),
     "hop-push-5": ("falls at 7.0 s", False),
     "hop-blow-5": ("falls at 6.8 s", False),
 }

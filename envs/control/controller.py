@@ -55,9 +55,11 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    clears when the burst ends.
 3. Ankles: u_muscle = ankle_gain a (each muscle its own cell's activation; one gain for every
    gait and network). A balance reflex adds to it on the ground (never replaces it):
-   b = k_ax (x_com - x_sup) + k_av v_com with x_sup the mean centre of the support feet;
-   b > 0 (centre of mass ahead) adds b to the support legs' extensors, b < 0 adds -b to their
-   flexors; clipped to [0, 1]. In double support the trailing leg (its foot behind the other)
+   b = k_ax (x_com - x_sup - x_bal) + k_av v_com with x_sup the mean centre of the support
+   feet and x_bal (blended, m) where the reflex holds the centre of mass ahead of that centre
+   (the jump's corner: over the ball of the foot); b > 0 (centre of mass ahead of that
+   reference) adds b to the support legs' extensors, b < 0 adds -b to their flexors; clipped
+   to [0, 1]. In double support the trailing leg (its foot behind the other)
    whose stance command is over adds push_off to its extensor: a push-off while the leading
    leg takes the weight, as the human triceps surae does before toe-off, which keeps its toes
    on the ground until its swing drive lifts it. ``--no-ankle-drive`` sets ankle_gain = 0 (the
@@ -159,6 +161,7 @@ class Corner:
     knee_hold: float  # double support: share of the trailing knee's further flexion held (0-1)
     land_yield: float  # share of the knee's extension drive withheld after a landing until
     # the knee stops flexing (0-1)
+    x_bal: float  # m: the balance reflex's reference, this far ahead of the support feet's centre
 
 
 @dataclass(frozen=True)

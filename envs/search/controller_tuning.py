@@ -114,10 +114,10 @@ CORNER_RANGES = dict(
     knee_crouch=(-1.0, -0.02), knee_swing=(-1.4, -0.2), knee_land=(-0.9, 0.0),
     kp_knee=(0.3, 5.0), kp_push=(0.1, 5.0), kp_air=(0.3, 5.0), kd_knee=(0.02, 0.3),
     push=(0.0, 1.0), swing_rest=(0.0, 1.0), x_clear=(-0.2, 0.3), push_off=(0.0, 0.6),
-    knee_hold=(0.0, 1.0), land_yield=(0.0, 1.0))
+    knee_hold=(0.0, 1.0), land_yield=(0.0, 1.0), x_bal=(-0.05, 0.10))
 # Gains added after the stages of scripts/tune_gains.sh that search every gain were run: a
 # search takes them only when --only names them, so that those stages reproduce.
-OPT_IN = ("land_yield", "lift_abort", "restart_v")
+OPT_IN = ("land_yield", "lift_abort", "restart_v", "x_bal")
 # ... and of the shared parameters.
 SHARED_RANGES = dict(ankle_gain=(0.05, 0.35), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
                      w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06), lift_abort=(0.0, 1.0),
@@ -675,6 +675,10 @@ def params_sha256(p: ControlParams) -> str:
     for gains in d["corners"].values():  # a gain added later, at its neutral value, is left
         for name, neutral in kernel.ADDED_NEUTRAL.items():  # out: older files hash as before
             if gains[name] == neutral:
+                del gains[name]
+    for gains in d.get("startup", {}).get("corners", {}).values():
+        for name in kernel.ADDED_AFTER_STARTUP:
+            if gains[name] == kernel.ADDED_NEUTRAL[name]:
                 del gains[name]
     for name, neutral in kernel.ADDED_NEUTRAL_SHARED.items():
         if d["shared"][name] == neutral:
