@@ -379,3 +379,23 @@ def test_the_schedule_moves_the_hopf_activation_with_the_parameters():
     assert np.allclose(s.a[before], walk.activation(s.v[before]))
     assert np.allclose(s.a[after], run.activation(s.v[after]))
     assert not np.allclose(s.a[after], walk.activation(s.v[after]))
+
+
+def test_balance_reference_moves_the_centre_of_mass_held_in_stance():
+    """x_bal moves the ankle reflex's reference (b = k_ax (x_com - x_sup - x_bal) + ...) ahead of
+    the support feet's centre: with the jump corner's reference 0.05 m further forward, the
+    centre of mass that the reflex holds while both feet stand (after 4 s, the start-up over)
+    sits forward by at least half that shift (the reflex saturates, the take-off moves the
+    body; a reflex that ignored x_bal would move it by about nothing)."""
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    m = load_model()
+    feet = [m.body(n).id for n in ("left_foot", "right_foot")]
+    held = {}
+    for x_bal in (0.0, 0.05):
+        p = CONTROL.with_corner("synchronous", x_bal=x_bal)
+        rec = rollout(build("ml", "jump"), 12.0, p, stop_on_fall=False)
+        both = (rec.contact.sum(axis=1) == 2) & (rec.t > 4.0)
+        x_sup = rec.body_pose[:, feet, 0].mean(axis=1) + K.FOOT_CENTRE_X
+        held[x_bal] = float(np.mean(rec.com_x[both] - x_sup[both]))
+    assert held[0.05] - held[0.0] >= 0.5 * 0.05, held
