@@ -9,14 +9,18 @@ model or on a copy of it with another ankle flexor. CMA-ES searches of the same 
 cost than height; a census has no such gradient and says whether a point that does both exists.
 
     python scripts/hop_gain_census.py [--n 3000] [--seed 2] [--box base|lean]
-        [--flexor 60] [--out out/hop_gain_census]
+        [--flexor 60] [--slope -150] [--out out/hop_gain_census]
 
 ``--box base``: knee_crouch, knee_ext, kp_push, kd_knee, push, pitch_d (0-0.5), kp_knee, k_ax,
 k_av, theta0 in the ranges of BOXES below; ``--box lean`` adds the trunk's gains (kp_t, kd_t,
-kf_t) and leans the trunk further (pitch_d 0.3-1.0 rad). ``--flexor G``: the ankle flexor's
+kf_t) and leans the trunk further (pitch_d 0.3-1.0 rad); ``--box bal`` adds the balance
+reflex's reference ahead of the feet's centre (x_bal, m; the jump's is 0.05, the ball of the foot). ``--flexor G``: the ankle flexor's
 torque at the neutral angle, N m per unit of activation (the model's ``gainprm="60 -150 0"``;
-100 or 140 make co-activation nearer a lock of the ankle). Writes OUT/census.json (every draw and
-its four rows: fell, physical gait, apex m, mean speed m/s, flight) and prints the summary:
+100 or 140 make co-activation nearer a lock of the ankle); ``--slope S`` its fall with
+dorsiflexion, N m/rad per unit (the model's -150; at -60 the flexor still pulls in the hop's
+crouch). Writes OUT/census.json (every draw and
+its four rows: fell, physical gait, apex m, mean speed m/s, flight, stride CV, stride period s,
+every hop criterion passed) and prints the summary:
 draws without a fall in the four states, draws named a hop in all four, the highest of those and
 its speed, the highest of those that stays within -0.05 m/s, and the correlation of the lowest
 apex with the mean speed over the standing draws. About 3.5 minutes per 3000 draws on 2 cores.
@@ -39,17 +43,19 @@ BASE_BOX = dict(knee_crouch=(-0.9, -0.2), knee_ext=(-0.4, 0.0), kp_push=(1.0, 5.
                 k_ax=(0.0, 20.0), k_av=(0.0, 3.0), theta0=(-0.2, 0.3))
 BOXES = {"base": BASE_BOX,
          "lean": {**BASE_BOX, "pitch_d": (0.3, 1.0), "kp_t": (0.5, 6.0), "kd_t": (0.05, 0.8),
-                  "kf_t": (-1.0, 1.0)}}
+                  "kf_t": (-1.0, 1.0)},
+         "bal": {**BASE_BOX, "x_bal": (-0.05, 0.15)}}
 APEX_M, SPEED_MPS = 0.04, -0.05  # issue 20's hop targets
 
 
-def write_body(out: Path, flexor: float) -> str:
+def write_body(out: Path, flexor: float, slope: float = -150.0) -> str:
     body = (ROOT / "models/biped/biped.xml").read_text()
     if 'gainprm="60 -150 0"' not in body:
         sys.exit("hop_gain_census: the model's flexor is not the one this census changes")
-    d = out / f"body_flexor_{flexor:g}"
+    d = out / f"body_flexor_{flexor:g}_{slope:g}"
     d.mkdir(parents=True, exist_ok=True)
-    (d / "biped.xml").write_text(body.replace('gainprm="60 -150 0"', f'gainprm="{flexor:g} -150 0"'))
+    (d / "biped.xml").write_text(body.replace('gainprm="60 -150 0"',
+                                              f'gainprm="{flexor:g} {slope:g} 0"'))
     (d / "scene.xml").write_text((ROOT / "models/biped/scene.xml").read_text())
     return str(d / "scene.xml")
 
@@ -71,7 +77,8 @@ def one(job):
         rec = rollout(net, SETTLE_S + MEASURED_S, params, poses=False, xml_path=scene)
         m = measure_recording(net, "hop", rec, SETTLE_S).summary()
         rows.append([bool(m["fell"]), m["physical_gait"], float(m.get("apex_height_m") or 0.0),
-                     float(m["speed_mps"] or 0.0), m.get("flight")])
+                     float(m["speed_mps"] or 0.0), m.get("flight"), m.get("stride_cv"),
+                     m.get("stride_period_s"), bool(m["passed"])])
     return {"i": i, "gains": gains, "rows": rows}
 
 
@@ -92,6 +99,8 @@ def summary(draws: list) -> dict:
             "in_place_hops": len(inplace),
             "highest_in_place_cm": None if best_in is None else round(100 * low(best_in, 2), 2),
             "target_met": sum(low(d, 2) >= APEX_M for d in inplace),
+            "passed_in_all": sum(all(r[7] for r in d["rows"]) for d in draws
+                                 if len(d["rows"][0]) > 7),
             "corr_apex_speed": (round(float(np.corrcoef(apex, speed)[0, 1]), 2)
                                 if len(up) > 2 else None)}
 
@@ -102,19 +111,22 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=2)
     ap.add_argument("--box", choices=sorted(BOXES), default="base")
     ap.add_argument("--flexor", type=float, default=60.0)
+    ap.add_argument("--slope", type=float, default=-150.0,
+                    help="the flexor's torque slope with dorsiflexion, N m/rad per unit (model -150)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="out/hop_gain_census")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    scene = (str(ROOT / "models/biped/scene.xml") if a.flexor == 60.0
-             else write_body(out, a.flexor))
+    scene = (str(ROOT / "models/biped/scene.xml") if (a.flexor, a.slope) == (60.0, -150.0)
+             else write_body(out, a.flexor, a.slope))
     rng = np.random.default_rng(a.seed)
     box = BOXES[a.box]
     jobs = [(i, {k: float(rng.uniform(*b)) for k, b in box.items()}, scene) for i in range(a.n)]
     with ProcessPoolExecutor(a.workers) as ex:
         draws = list(ex.map(one, jobs, chunksize=4))
     res = {"command": " ".join(sys.argv), "seeds": SEEDS, "box": box, "flexor": a.flexor,
+           "slope": a.slope,
            "summary": summary(draws), "draws": draws}
     (out / "census.json").write_text(json.dumps(res))
     print(json.dumps(res["summary"]))
