@@ -399,3 +399,24 @@ def test_balance_reference_moves_the_centre_of_mass_held_in_stance():
         x_sup = rec.body_pose[:, feet, 0].mean(axis=1) + K.FOOT_CENTRE_X
         held[x_bal] = float(np.mean(rec.com_x[both] - x_sup[both]))
     assert held[0.05] - held[0.0] >= 0.5 * 0.05, held
+
+
+def test_lean_knee_leans_the_trunk_with_the_knees_flexion():
+    """lean_knee raises the trunk's pitch target by lean_knee x the knees' mean flexion (rad per
+    rad; the controller's docstring, step 4): with 0.5 at the walk's corner the walking trunk
+    (after 4 s, the start-up over) leans forward by at least half of 0.5 x the mean flexion it
+    walks with (the trunk's PD loop lags its target and the gait changes with the lean; a
+    controller that ignored lean_knee would lean by about nothing more)."""
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    lean = {}
+    flex = 0.0
+    for g in (0.0, 0.5):
+        rec = rollout(build("ml", "walk"), 10.0, CONTROL.with_corner("alternating", lean_knee=g),
+                      stop_on_fall=False)
+        late = rec.t > 4.0
+        lean[g] = float(np.mean(rec.torso_pitch[late]))
+        if g:
+            flex = float(np.mean(np.maximum(0.0, -rec.joints[late][:, [1, 4]].mean(axis=1))))
+    assert flex > 0.1, flex
+    assert lean[0.5] - lean[0.0] >= 0.5 * 0.5 * flex, (lean, flex)

@@ -30,14 +30,15 @@ SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
-           "land_yield", "x_bal")
+           "land_yield", "x_bal", "lean_knee")
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
-ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0}
+ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
+                 "lean_knee": 0.0}
 ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
-ADDED_AFTER_STARTUP = ("x_bal",)
+ADDED_AFTER_STARTUP = ("x_bal", "lean_knee")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -197,9 +198,10 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                     G[n] += w01 * (nu_ac - nu) * (P[P_SIZE + 4 * n + 1] - P[m])
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal) = (
+     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
-        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24], G[25])
+        G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24], G[25],
+        G[26])
     push_off = max(0.0, push_off)
     knee_hold = _clip01(knee_hold)
     land_yield = _clip01(land_yield)
@@ -311,6 +313,8 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     # Ankles: the CPG's drive at one gain; a balance reflex adds to it on the ground.
     for c in range(4):
         u[c] = ankle_gain * a[c]
+    if lean_knee != 0.0:  # a squat leans the trunk with the knees' flexion
+        pitch_d += lean_knee * max(0.0, -0.5 * (knee[0] + knee[1]))
     tau_torso = kp_t * (pitch_d - pitch) - kd_t * pitch_rate
     if n_support > 0:
         sup_x /= n_support

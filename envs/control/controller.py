@@ -65,7 +65,10 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    on the ground until its swing drive lifts it. ``--no-ankle-drive`` sets ankle_gain = 0 (the
    reflexes stay).
 4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
-   tau_torso = kp_t (pitch_d - pitch) - kd_t pitch_rate;
+   tau_torso = kp_t (pitch_d' - pitch) - kd_t pitch_rate, with the pitch target
+   pitch_d' = pitch_d + lean_knee max(0, -(q_knee,L + q_knee,R) / 2) (blended lean_knee, rad
+   per rad of the knees' mean flexion, neutral 0: a squat leans the trunk to keep the centre of
+   mass over the feet; 0 at every corner of the committed gains, scripts/hop_squat_search.py);
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
    thigh angle in the world as target
        theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
@@ -162,6 +165,7 @@ class Corner:
     land_yield: float  # share of the knee's extension drive withheld after a landing until
     # the knee stops flexing (0-1)
     x_bal: float  # m: the balance reflex's reference, this far ahead of the support feet's centre
+    lean_knee: float  # rad of trunk pitch target per rad of mean knee flexion
 
 
 @dataclass(frozen=True)
