@@ -8,14 +8,15 @@ model or on a copy of it with another ankle flexor. CMA-ES searches of the same 
 (docs/JOURNAL.md) walk back to a low hop because staying upright is worth more to the tuner's
 cost than height; a census has no such gradient and says whether a point that does both exists.
 
-    python scripts/hop_gain_census.py [--n 3000] [--seed 2] [--box base|lean|bal|squat]
+    python scripts/hop_gain_census.py [--n 3000] [--seed 2] [--box base|lean|bal|squat|squat_kav]
         [--flexor 60] [--slope -150] [--out out/hop_gain_census]
 
 ``--box base``: knee_crouch, knee_ext, kp_push, kd_knee, push, pitch_d (0-0.5), kp_knee, k_ax,
 k_av, theta0 in the ranges of BOXES below; ``--box lean`` adds the trunk's gains (kp_t, kd_t,
 kf_t) and leans the trunk further (pitch_d 0.3-1.0 rad); ``--box bal`` adds the balance
 reflex's reference ahead of the feet's centre (x_bal, m; the jump's is 0.05, the ball of the foot);
-``--box squat`` also the trunk's lean with the knees' flexion (lean_knee, rad per rad) and its gains. ``--flexor G``: the ankle flexor's
+``--box squat`` also the trunk's lean with the knees' flexion (lean_knee, rad per rad) and its gains,
+``--box squat_kav`` the same with k_av held at the committed value. ``--flexor G``: the ankle flexor's
 torque at the neutral angle, N m per unit of activation (the model's ``gainprm="60 -150 0"``;
 100 or 140 make co-activation nearer a lock of the ankle); ``--slope S`` its fall with
 dorsiflexion, N m/rad per unit (the model's -150; at -60 the flexor still pulls in the hop's
@@ -48,6 +49,9 @@ BOXES = {"base": BASE_BOX,
          "bal": {**BASE_BOX, "x_bal": (-0.05, 0.15)},
          "squat": {**BASE_BOX, "x_bal": (-0.05, 0.15), "lean_knee": (0.0, 1.5),
                    "kp_t": (1.0, 6.0), "kd_t": (0.05, 0.8)}}
+# ... the same without the velocity reflex, held at the committed corner's k_av (the run's
+# start-up blends it: scripts/hop_squat_search.py)
+BOXES["squat_kav"] = {k: b for k, b in BOXES["squat"].items() if k != "k_av"}
 APEX_M, SPEED_MPS = 0.04, -0.05  # issue 20's hop targets
 
 
