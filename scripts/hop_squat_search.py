@@ -11,7 +11,7 @@ every corner of the committed gains) are searched in three steps, on tuning CPG 
    are named a hop in all four states with one take-off per CPG cycle (stride longer than 0.5 s)
    and stay in place (mean speed >= -0.05 m/s), the one whose lowest apex is highest (draw 619:
    2.2 cm, +0.03 to +0.06 m/s);
-2. three rounds of a local random search (each neighbour: every gain moved by FRAC of its box
+2. three steps of a local random search (each neighbour: every gain moved by FRAC of its box
    times a standard normal, clipped; 40 neighbours a round; the best kept if it improves), scored
    on the hop preset from CPG seeds 1000-1003 (2 s + 12 s): per state 10 for a fall, else 2 if
    not named a hop plus the shortfalls from apex 4.5 cm (per cm), stride CV 0.04 (per 0.02) and
