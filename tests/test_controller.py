@@ -420,3 +420,35 @@ def test_lean_knee_leans_the_trunk_with_the_knees_flexion():
             flex = float(np.mean(np.maximum(0.0, -rec.joints[late][:, [1, 4]].mean(axis=1))))
     assert flex > 0.1, flex
     assert lean[0.5] - lean[0.0] >= 0.5 * 0.5 * flex, (lean, flex)
+
+
+def test_toe_up_dorsiflexes_the_swinging_foot_behind_the_hip():
+    """toe_up adds flexor activation to a leg whose foot is off the ground and more than 0.1 m
+    behind the hip (the controller's docstring, step 3). The ankle's static balance under an
+    activation a of its flexor (models/biped: force a (60 - 150 q) N m against the joint's
+    50 N m/rad spring) is q = 60 a / (50 + 150 a): 0.24 rad for a = 0.5. At the run's corner,
+    the ankle of a foot in the air with its centre more than 0.2 m behind the hip (where the
+    gate is full) turns at least half of that further towards dorsiflexion than without (the
+    activation's 30 ms filter and the leg's swing keep it from the static value); a controller
+    that ignored toe_up would not turn it at all."""
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    m = load_model()
+    feet, torso = (m.body("left_foot").id, m.body("right_foot").id), m.body("torso").id
+    angle = {}
+    for g in (0.0, 0.5):
+        rec = rollout(build("ml", "run"), 8.0, CONTROL.with_corner("alternating_coactive",
+                                                                    toe_up=g),
+                      stop_on_fall=False)
+        late = rec.t > 3.0
+        q = []
+        for i, (foot, ankle) in enumerate(zip(feet, (2, 5))):
+            behind = (rec.body_pose[:, torso, 0] - rec.body_pose[:, foot, 0]
+                      - K.FOOT_CENTRE_X > 0.2)
+            swing = (rec.modes[:, i] != K.MODE_SUPPORT) & (rec.contact[:, i] == 0)
+            q.append(rec.joints[late & behind & swing, ankle])
+        q = np.concatenate(q)
+        assert len(q) > 100, len(q)
+        angle[g] = float(np.mean(q))
+    static = 60 * 0.5 / (50 + 150 * 0.5)
+    assert angle[0.5] - angle[0.0] >= 0.5 * static, (angle, static)

@@ -64,18 +64,25 @@ _HOP = "apex 1.6-1.9 cm below 4 cm; drifts back at 0.07 m/s (limit 0.05)"
 
 KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
     # since the jump corner's balance reference (2026-12-05, scripts/jump_balance_reference.py):
-    # walk, run and jump pass in all 13 (before it the jump fell at friction x1.3 at 8.4 s)
+    # walk, run and jump passed in all 13 (before it the jump fell at friction x1.3 at 8.4 s)
     **{f"hop-{cid}": (_HOP, True) for cid in CONDITION_IDS},
+    # since the run's swing clearance (2026-12-05, session 34, scripts/run_toe_clearance.py):
+    # the run's duty at the criterion's edge on one floor (0.31 on the others)
+    "run-friction0.7": ("duty factor 0.296 left and 0.297 right (0.295 and 0.300 with feedback), "
+                        "below 0.30", False),
 
     # perturbations (non-strict: a fall or a name at a threshold's edge is chaotic). Since the
-    # jump corner's balance reference the jump keeps its gait on friction x0.5 and x2.0 (named
-    # a hop and falling at 4.7 s before it) and the run on x0.5 (falling at 1.5 s before it)
-    "run-friction2.0": ("falls at 2.5 s, in the start-up", False),
-    "run-blow-5": ("falls at 7.7 s", False),
-    "jump-push+5": ("falls at 7.3 s: pushed forwards in its flexor burst, it takes off from its "
+    # run's swing clearance the run keeps its gait on friction x2.0 and after the backward blow
+    # (it fell at 2.5 and 7.7 s before) and falls on x0.5 in its start-up, which it kept
+    # before; the hop on x2.0 is not named a hop (over tuning CPG states 1000-1019 it is named
+    # a hop on x2.0 in 4 of 20 with the gains before and 3 of 20 with these)
+    "run-friction0.5": ("falls at 2.5 s, in the start-up", False),
+    "jump-push+5": ("falls at 7.5 s: pushed forwards in its flexor burst, it takes off from its "
                     "toes and runs away forwards", False),
+    "hop-friction2.0": ("no fall, but not named a hop: flight 0.10 at the pattern's edge",
+                        False),
     "hop-push-5": ("falls at 7.0 s", False),
-    "hop-blow-5": ("falls at 6.8 s", False),
+    "hop-blow-5": ("falls at 6.9 s", False),
 }
 
 

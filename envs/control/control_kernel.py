@@ -30,15 +30,15 @@ SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
-           "land_yield", "x_bal", "lean_knee")
+           "land_yield", "x_bal", "lean_knee", "toe_up")
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
-                 "lean_knee": 0.0}
+                 "lean_knee": 0.0, "toe_up": 0.0}
 ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
-ADDED_AFTER_STARTUP = ("x_bal", "lean_knee")
+ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -68,6 +68,9 @@ S_SIZE = 28
 TAU_FEATURE = 0.5  # s: time constant of those running averages
 # Leg modes (S_MODE), for recordings and tests.
 MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
+# toe_up acts on a foot off the ground more than this far behind the hip (m): the early swing,
+# where the tucked shank points the toes at the floor; it has faded before the landing.
+TOE_UP_BEHIND_M = 0.1
 
 # Recording columns, one row per control tick.
 # R_V: CPG outputs; R_DRIVE: their activations (the CPG's drive); R_ACT: the ankle muscles'
@@ -198,10 +201,10 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                     G[n] += w01 * (nu_ac - nu) * (P[P_SIZE + 4 * n + 1] - P[m])
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee) = (
+     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee, toe_up) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
         G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24], G[25],
-        G[26])
+        G[26], G[27])
     push_off = max(0.0, push_off)
     knee_hold = _clip01(knee_hold)
     land_yield = _clip01(land_yield)
@@ -383,6 +386,11 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             behind = _clip01((hip_x + x_clear - foot_x[i]) / 0.05)
             target = knee_land + (knee_swing - knee_land) * g[i] * behind
             k = kp_air * (target - knee[i]) - kd_knee * knee_rate[i]
+            # Swing clearance: the dorsiflexor lifts the toes of a foot off the ground while
+            # it is behind the hip, early in the swing (toe_up, activation; 0 adds nothing).
+            if toe_up > 0.0 and not ground[i]:
+                u[i] = min(u[i] + toe_up * _clip01(
+                    (hip_x - foot_x[i] - TOE_UP_BEHIND_M) / 0.05), 1.0)
         u[4 + i] = _clip1(tau_hip[i])
         u[6 + i] = _clip1(k)
 

@@ -62,8 +62,15 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    to [0, 1]. In double support the trailing leg (its foot behind the other)
    whose stance command is over adds push_off to its extensor: a push-off while the leading
    leg takes the weight, as the human triceps surae does before toe-off, which keeps its toes
-   on the ground until its swing drive lifts it. ``--no-ankle-drive`` sets ankle_gain = 0 (the
-   reflexes stay).
+   on the ground until its swing drive lifts it. A leg in the air or lifting whose foot is
+   off the ground adds toe_up (blended, neutral 0) to its flexor while the foot is behind the
+   hip, early in the swing,
+       u_flex,i += toe_up clip((x_hip - x_foot,i - 0.1 m) / 0.05 m, 0, 1)
+   (x_foot the foot's centre; kernel.TOE_UP_BEHIND_M = 0.1 m): the swing's dorsiflexion that
+   clears the toes, as the human tibialis anterior does (a tucked shank otherwise points the
+   passive foot's toes at the floor, and the run stubbed them); it has faded before the
+   landing. ``--no-ankle-drive``
+   sets ankle_gain = 0 (the reflexes stay).
 4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
    tau_torso = kp_t (pitch_d' - pitch) - kd_t pitch_rate, with the pitch target
    pitch_d' = pitch_d + lean_knee max(0, -(q_knee,L + q_knee,R) / 2) (blended lean_knee, rad
@@ -166,6 +173,7 @@ class Corner:
     # the knee stops flexing (0-1)
     x_bal: float  # m: the balance reflex's reference, this far ahead of the support feet's centre
     lean_knee: float  # rad of trunk pitch target per rad of mean knee flexion
+    toe_up: float  # swing: dorsiflexor activation added while the foot is behind the hip
 
 
 @dataclass(frozen=True)
