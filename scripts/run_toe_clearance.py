@@ -34,7 +34,7 @@ RULE = ("rule fixed before a test condition saw a candidate (tuning CPG seeds on
         "a census on CPG seeds 2450-2479 (unused) has at most 2 more falls over the four gaits "
         "and fewer falls of the run over 90 s, the Table 3 transitions keep in-family >= 3 of 16 "
         "and cross-family >= 4 of 8, and the matrices keep Morris-Lecar 4/4, Hopf >= 3/4 and the "
-        "Matsuoka walk >= 2 m. Measured after stage rc: walk 13, run 12 (x0.7: duty 0.2996), "
+        "Matsuoka walk >= 2 m. Measured after stage rc: walk 13, run 12 (x0.7: duty 0.296 / 0.297), "
         "jump 13, open loop and with feedback; perturbations 12 of 16 (the run keeps x2.0 and "
         "falls on x0.5 in its start-up; the hop on x2.0 is no longer named a hop): NOT met as "
         "written; Table 3 quality met; census 2450-2479 falls walk/run/jump/hop 1/2/0/4 -> "

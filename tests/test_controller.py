@@ -425,8 +425,9 @@ def test_lean_knee_leans_the_trunk_with_the_knees_flexion():
 def test_toe_up_dorsiflexes_the_swinging_foot_behind_the_hip():
     """toe_up adds flexor activation to a leg whose foot is off the ground and more than 0.1 m
     behind the hip (the controller's docstring, step 3). The ankle's static balance under an
-    activation a of its flexor (models/biped: force a (60 - 150 q) N m against the joint's
-    50 N m/rad spring) is q = 60 a / (50 + 150 a): 0.24 rad for a = 0.5. At the run's corner,
+    activation a of its flexor (models/biped: force a (F0 + S q) N m, F0 = 60, S = -150, read
+    from the model, against the joint's spring k = 50 N m/rad) is q = F0 a / (k - S a): 0.24
+    rad for a = 0.5. At the run's corner,
     the ankle of a foot in the air with its centre more than 0.2 m behind the hip (where the
     gate is full) turns at least half of that further towards dorsiflexion than without (the
     activation's 30 ms filter and the leg's swing keep it from the static value); a controller
@@ -450,5 +451,8 @@ def test_toe_up_dorsiflexes_the_swinging_foot_behind_the_hip():
         q = np.concatenate(q)
         assert len(q) > 100, len(q)
         angle[g] = float(np.mean(q))
-    static = 60 * 0.5 / (50 + 150 * 0.5)
+    f0, slope = m.actuator("LF").gainprm[:2]
+    k = m.jnt_stiffness[m.joint("left_ankle").id]
+    static = f0 * 0.5 / (k - slope * 0.5)
+    assert static == pytest.approx(0.24)
     assert angle[0.5] - angle[0.0] >= 0.5 * static, (angle, static)
