@@ -9,7 +9,7 @@ model or on a copy of it with another ankle flexor. CMA-ES searches of the same 
 cost than height; a census has no such gradient and says whether a point that does both exists.
 
     python scripts/hop_gain_census.py [--n 3000] [--seed 2] [--box base|lean|bal|squat|squat_kav]
-        [--flexor 60] [--slope -150] [--out out/hop_gain_census]
+        [--flexor 60] [--slope -150] [--base GAINS.json] [--out out/hop_gain_census]
 
 ``--box base``: knee_crouch, knee_ext, kp_push, kd_knee, push, pitch_d (0-0.5), kp_knee, k_ax,
 k_av, theta0 in the ranges of BOXES below; ``--box lean`` adds the trunk's gains (kp_t, kd_t,
@@ -67,20 +67,26 @@ def write_body(out: Path, flexor: float, slope: float = -150.0) -> str:
     return str(d / "scene.xml")
 
 
+def base_params(base: str | None):
+    """The gains the drawn hop corner goes into: the file ``base``, or the controller's own."""
+    from cpgbiped.envs.control.controller import CONTROL, read_gains
+    return CONTROL if base is None else read_gains(base)[0]
+
+
 def one(job):
-    """One draw rolled out from each CPG state: job (i, gains, scene[, seeds]), seeds default
-    SEEDS."""
+    """One draw rolled out from each CPG state: job (i, gains, scene[, seeds[, base]]), seeds
+    default SEEDS, base (a gains file the hop corner goes into) default the controller's."""
     i, gains, scene = job[:3]
-    seeds = job[3] if len(job) > 3 else SEEDS
+    seeds = job[3] if len(job) > 3 and job[3] is not None else SEEDS
+    base = job[4] if len(job) > 4 else None
     import numba
     numba.set_num_threads(1)
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import CONTROL
     from cpgbiped.envs.gaits.criteria import SETTLE_S
     from cpgbiped.envs.gaits.validate import measure_recording
     from cpgbiped.envs.simulation.rollout import rollout
 
-    params = CONTROL.with_corner("synchronous_coactive", **gains)
+    params = base_params(base).with_corner("synchronous_coactive", **gains)
     rows = []
     for s in seeds:
         net = build("ml", "hop", seed=s)
@@ -122,6 +128,8 @@ def main() -> None:
     ap.add_argument("--flexor", type=float, default=60.0)
     ap.add_argument("--slope", type=float, default=-150.0,
                     help="the flexor's torque slope with dorsiflexion, N m/rad per unit (model -150)")
+    ap.add_argument("--base", help="gains file the drawn hop corner goes into (default: the "
+                    "controller's, envs/control/gains.json)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="out/hop_gain_census")
     a = ap.parse_args()
@@ -131,7 +139,8 @@ def main() -> None:
              else write_body(out, a.flexor, a.slope))
     rng = np.random.default_rng(a.seed)
     box = BOXES[a.box]
-    jobs = [(i, {k: float(rng.uniform(*b)) for k, b in box.items()}, scene) for i in range(a.n)]
+    jobs = [(i, {k: float(rng.uniform(*b)) for k, b in box.items()}, scene, None, a.base)
+            for i in range(a.n)]
     with ProcessPoolExecutor(a.workers) as ex:
         draws = list(ex.map(one, jobs, chunksize=4))
     res = {"command": " ".join(sys.argv), "seeds": SEEDS, "box": box, "flexor": a.flexor,

@@ -24,7 +24,13 @@ Each step's random numbers come from numpy default_rng(5). Writes OUT/census.jso
 given), OUT/steps.json (every round's best) and OUT/gains.json (the committed gains with the
 hop corner replaced). About 12 minutes on 2 cores with the census, 8 without.
 
-    python scripts/hop_squat_search.py [--census FILE] [--out out/hop_squat]
+    python scripts/hop_squat_search.py [--census FILE] [--census-box squat|squat_kav]
+        [--census-seed 9] [--base GAINS.json] [--into GAINS.json] [--out out/hop_squat]
+
+(--base: the gains the hop corner is scored with, default the controller's; --into: a gains
+file whose hop corner the result replaces as a link of a tuning chain, set_by_hand's entry.)
+Session 33's second candidate, with the velocity reflex held: ``--census-box squat_kav
+--census-seed 10``, scored with the gains of that day (before the run's swing clearance).
 
 What it found (2026-12-05): over tuning states 1000-1019 the hop passes every criterion in 20
 of 20 (apex 4.9-5.3 cm, forward at 0.24-0.32 m/s, stride CV 2-3%), the walk in 20 and the jump
@@ -48,10 +54,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import hop_gain_census as hgc  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-CENSUS_ARGS = ["--n", "3000", "--seed", "9", "--box", "squat"]
 LOCAL_STEPS = ((8, 40, 0.05), (20, 40, 0.06), (20, 40, 0.05))  # rounds, neighbours, FRAC
 GUARDED_STEP = (16, 32, 0.05)
 RNG_SEED = 5
+# The provenance note of a chain's link (--into): what was found and how; why it was adopted
+# goes into the note of the link that adopts it.
+INTO_NOTE = ("the hop corner found by python scripts/hop_squat_search.py {args} (census draw "
+             "{draw}, the local search's random numbers default_rng(5)), scored on tuning CPG "
+             "states with the other gains of --base")
 HOP_SEEDS_LOCAL = (1000, 1001, 1002, 1003)
 HOP_SEEDS_GUARDED = tuple(range(1000, 1008))
 RUN_SEEDS_GUARDED = (1000, 1001, 1002, 1003)
@@ -83,27 +93,26 @@ def hop_score(rows: list) -> float:
     return s / len(rows)
 
 
-def hop_rows(i: int, gains: dict, seeds: tuple) -> list:
-    return hgc.one((i, gains, str(ROOT / "models/biped/scene.xml"), seeds))["rows"]
+def hop_rows(i: int, gains: dict, seeds: tuple, base: str | None = None) -> list:
+    return hgc.one((i, gains, str(ROOT / "models/biped/scene.xml"), seeds, base))["rows"]
 
 
 def local_one(job):
-    i, gains = job
-    return gains, hop_score(hop_rows(i, gains, HOP_SEEDS_LOCAL))
+    i, gains, base = job
+    return gains, hop_score(hop_rows(i, gains, HOP_SEEDS_LOCAL, base))
 
 
 def guarded_one(job):
     """hop_score over HOP_SEEDS_GUARDED plus the run's guard: 10 per fall, 3 per rollout not
     named a run, averaged over RUN_SEEDS_GUARDED."""
-    i, gains = job
+    i, gains, base = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import CONTROL
     from cpgbiped.envs.gaits.criteria import SETTLE_S
     from cpgbiped.envs.gaits.validate import measure_recording
     from cpgbiped.envs.simulation.rollout import rollout
 
-    s = hop_score(hop_rows(i, gains, HOP_SEEDS_GUARDED))
-    params = CONTROL.with_corner("synchronous_coactive", **gains)
+    s = hop_score(hop_rows(i, gains, HOP_SEEDS_GUARDED, base))
+    params = hgc.base_params(base).with_corner("synchronous_coactive", **gains)
     guard = 0
     for seed in RUN_SEEDS_GUARDED:
         net = build("ml", "run", seed=seed)
@@ -113,14 +122,15 @@ def guarded_one(job):
     return gains, s + guard / len(RUN_SEEDS_GUARDED)
 
 
-def climb(ex, start: dict, rounds: int, n: int, frac: float, score_one, log: list) -> dict:
+def climb(ex, start: dict, rounds: int, n: int, frac: float, score_one, log: list,
+          base: str | None = None) -> dict:
     box = hgc.BOXES["squat"]
     rng = np.random.default_rng(RNG_SEED)
     best = dict(start)
-    best_score = list(ex.map(score_one, [(0, best)]))[0][1]
+    best_score = list(ex.map(score_one, [(0, best, base)]))[0][1]
     for k in range(rounds):
         jobs = [(i, {q: float(np.clip(best[q] + frac * (box[q][1] - box[q][0]) * rng.normal(),
-                                      *box[q])) for q in best}) for i in range(n)]
+                                      *box[q])) for q in best}, base) for i in range(n)]
         res = list(ex.map(score_one, jobs))
         i = int(np.argmin([r[1] for r in res]))
         if res[i][1] < best_score:
@@ -133,12 +143,22 @@ def climb(ex, start: dict, rounds: int, n: int, frac: float, score_one, log: lis
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--census", help="census.json of the census above (else it is run)")
+    ap.add_argument("--census-box", default="squat", choices=("squat", "squat_kav"),
+                    help="the census's box when the census is run here (squat_kav: k_av held)")
+    ap.add_argument("--census-seed", type=int, default=9)
+    ap.add_argument("--base", help="gains file the hop corner goes into, for the scores and the "
+                    "result (default: the controller's, envs/control/gains.json)")
+    ap.add_argument("--into", help="gains file whose hop corner the result replaces, with a "
+                    "provenance entry (default: --base, without one)")
     ap.add_argument("--out", default="out/hop_squat")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     if a.census is None:
-        subprocess.run([sys.executable, str(ROOT / "scripts/hop_gain_census.py"), *CENSUS_ARGS,
+        args = ["--n", "3000", "--seed", str(a.census_seed), "--box", a.census_box]
+        if a.base:
+            args += ["--base", a.base]
+        subprocess.run([sys.executable, str(ROOT / "scripts/hop_gain_census.py"), *args,
                         "--out", str(out)], check=True)
         a.census = str(out / "census.json")
     start = choose_start(json.loads(Path(a.census).read_text()))
@@ -147,12 +167,18 @@ def main() -> None:
     best = start["gains"]
     with ProcessPoolExecutor(2) as ex:
         for rounds, n, frac in LOCAL_STEPS:
-            best = climb(ex, best, rounds, n, frac, local_one, log)
-        best = climb(ex, best, *GUARDED_STEP, guarded_one, log)
+            best = climb(ex, best, rounds, n, frac, local_one, log, a.base)
+        best = climb(ex, best, *GUARDED_STEP, guarded_one, log, a.base)
     (out / "steps.json").write_text(json.dumps({"start_draw": start["i"], "rounds": log}))
-    gains = json.loads((ROOT / "envs/control/gains.json").read_text())
-    gains["corners"]["synchronous_coactive"].update(best)
-    (out / "gains.json").write_text(json.dumps(gains, indent=1))
+    if a.into:  # a link of the tuning chain (scripts/tune_gains.sh)
+        from cpgbiped.envs.search.controller_tuning import set_by_hand
+        set_by_hand(a.into, {f"synchronous_coactive.{g}": v for g, v in best.items()},
+                    out / "gains.json", INTO_NOTE.format(
+                        args=" ".join(sys.argv[1:]), draw=start["i"]))
+    else:
+        gains = json.loads(Path(a.base or ROOT / "envs/control/gains.json").read_text())
+        gains["corners"]["synchronous_coactive"].update(best)
+        (out / "gains.json").write_text(json.dumps(gains, indent=1))
     print(json.dumps(best))
 
 

@@ -606,6 +606,14 @@ def test_gains_set_by_hand_are_a_link_of_the_chain(tmp_path):
     assert prov[-1]["result_sha256"] == params_sha256(p) != params_sha256(CONTROL)
     with pytest.raises(InputError, match="unknown gain"):
         set_by_hand(GAINS_FILE, {"alternating.no_such_gain": 1.0}, out, "bad")
+    # a start-up corner's gain (a link found by scripts/walk_startup_search.py): that start-up
+    # gain alone changes, the corner of the same name keeps its value
+    set_by_hand(GAINS_FILE, {"startup.alternating.k_ax": 0.5}, out, "a test")
+    p, prov = read_gains(out)
+    assert p.startup[0].k_ax == 0.5 != CONTROL.startup[0].k_ax
+    assert p.corner("alternating") == CONTROL.corner("alternating")
+    assert replace(p, startup=CONTROL.startup) == CONTROL
+    assert prov[-1]["part"] == ["startup.alternating"]
 
 
 def test_guard_counts_only_a_guarded_gaits_excess_over_its_reference():

@@ -807,13 +807,13 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
     base, provenance = read_gains(start)
     names = list(values)
     known = {v[0] for v in variables(TuneSettings(gaits=GAITS, search="both", only=tuple(
-        n.split(".")[-1] for n in names)))}
+        n.split(".")[-1] for n in names) + tuple(n for n in names if n.startswith(STARTUP))))}
     bad = [n for n in names if n not in known]
     if bad:
         raise InputError(f"unknown gain {', '.join(map(repr, bad))}: use <corner>.<gain> or a "
                          f"shared name")
     p = with_values(base, names, [values[n] for n in names])
-    entry = {"part": sorted({n.split(".")[0] for n in names if "." in n}) or ["shared"],
+    entry = {"part": sorted({n.rsplit(".", 1)[0] for n in names if "." in n}) or ["shared"],
              "hand_set": True, "set": {n: float(values[n]) for n in names}, "note": why,
              "command": f"set by hand ({', '.join(names)})",
              "started_from": str(start), "started_from_sha256": params_sha256(base),
