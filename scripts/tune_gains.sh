@@ -3,7 +3,7 @@
 # (envs/control/gains_root.json): the chain of `cpgbiped tune` runs that made the committed file, in
 # order, each started from the one before. Every run is deterministic (its seed, its tuning
 # conditions), so the chain ends with the committed parameters, bit for bit; the last line
-# checks it. About 222 minutes on 2 cores. Usage:
+# checks it. About 250 minutes on 2 cores. Usage:
 #     bash scripts/tune_gains.sh [OUT]          (default OUT: out/tune_chain)
 # then `cp OUT/final/gains.json envs/control/gains.json` makes the result the controller's gains.
 set -euo pipefail
@@ -121,6 +121,17 @@ prev="$OUT/jb/gains.json"
 python3 scripts/run_toe_clearance.py "$prev" "$OUT"
 prev="$OUT/tc/gains.json"
 stage rc --gait run --only "$(python3 scripts/run_toe_clearance.py --free)" --conditions 8 --seconds 30 --gens 50 --pop 16 --sigma 0.06 --seed 344 --shortfall-weight 30
+# The hop (README, "Status"; journal, sessions 33 and 35): session 33's hop corner, whose trunk
+# leans with the knees' flexion (lean_knee) and whose velocity reflex is held at the run's
+# start-up's, found by a census and a local search on tuning states scored with the gains of
+# that day (stage jb's, before the run's swing clearance); then the walk's start-up corner
+# searched so that the walk starts without leaps (with the hop corner's share of the first
+# second the walk's start-up had fallen from one state), adopted under a rule on rates over
+# unused states. About 25 minutes.
+python3 scripts/hop_squat_search.py --census-box squat_kav --census-seed 10 --base "$OUT/jb/gains.json" --into "$prev" --out "$OUT/hs"
+prev="$OUT/hs/gains.json"
+python3 scripts/walk_startup_search.py --start "$prev" --guard falls --out "$OUT/ws"
+prev="$OUT/ws/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

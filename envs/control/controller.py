@@ -75,7 +75,8 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    tau_torso = kp_t (pitch_d' - pitch) - kd_t pitch_rate, with the pitch target
    pitch_d' = pitch_d + lean_knee max(0, -(q_knee,L + q_knee,R) / 2) (blended lean_knee, rad
    per rad of the knees' mean flexion, neutral 0: a squat leans the trunk to keep the centre of
-   mass over the feet; 0 at every corner of the committed gains, scripts/hop_squat_search.py);
+   mass over the feet; 0.75 at the hop's corner of the committed gains since session 35, 0 at the
+   others: scripts/hop_squat_search.py);
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
    thigh angle in the world as target
        theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
