@@ -16,8 +16,9 @@ k_av, theta0 in the ranges of BOXES below; ``--box lean`` adds the trunk's gains
 kf_t) and leans the trunk further (pitch_d 0.3-1.0 rad); ``--box bal`` adds the balance
 reflex's reference ahead of the feet's centre (x_bal, m; the jump's is 0.05, the ball of the foot);
 ``--box squat`` also the trunk's lean with the knees' flexion (lean_knee, rad per rad) and its gains,
-``--box squat_kav`` the same with k_av held at the committed value. ``--flexor G``: the ankle flexor's
-torque at the neutral angle, N m per unit of activation (the model's ``gainprm="60 -150 0"``;
+``--box squat_kav`` the same with k_av held (at --base's value, default the controller's).
+``--flexor G``: the ankle flexor's torque at the neutral angle, N m per unit of activation (the
+model's ``gainprm="60 -150 0"``;
 100 or 140 make co-activation nearer a lock of the ankle); ``--slope S`` its fall with
 dorsiflexion, N m/rad per unit (the model's -150; at -60 the flexor still pulls in the hop's
 crouch). Writes OUT/census.json (every draw and

@@ -1,10 +1,11 @@
 """A hop that leans into its squat: the search that found it, from the census to the candidate.
 
-A lead for issue 20's hop, not a link of the committed tuning chain (docs/JOURNAL.md, "The hop's
-rhythm against the body's bounce", session 33). The hop corner's gains plus the blended gain
-``lean_knee`` (the trunk's pitch target grows by lean_knee rad per rad of the knees' mean
-flexion, as a human squat leans the trunk to keep the centre of mass over the feet; neutral 0 at
-every corner of the committed gains) are searched in three steps, on tuning CPG states only:
+Issue 20's hop (docs/JOURNAL.md, "The hop's rhythm against the body's bounce", session 33;
+sessions 34 and 35): with ``--census-box squat_kav --census-seed 10`` a link of the committed
+tuning chain since session 35 (scripts/tune_gains.sh). The hop corner's gains plus the blended
+gain ``lean_knee`` (the trunk's pitch target grows by lean_knee rad per rad of the knees' mean
+flexion, as a human squat leans the trunk to keep the centre of mass over the feet; neutral 0,
+0.75 at the committed hop corner) are searched in three steps, on tuning CPG states only:
 
 1. the census ``python scripts/hop_gain_census.py --n 3000 --seed 9 --box squat`` (or --census
    FILE, its census.json), from which the start is chosen by a rule: of the draws that stand and
@@ -21,8 +22,10 @@ every corner of the committed gains) are searched in three steps, on tuning CPG 
    because the hop corner's gains blend into every gait's start-up.
 
 Each step's random numbers come from numpy default_rng(5). Writes OUT/census.json (unless
-given), OUT/steps.json (every round's best) and OUT/gains.json (the committed gains with the
-hop corner replaced). About 12 minutes on 2 cores with the census, 8 without.
+given; --census-box, --census-seed and --base's census apply only to a census run here),
+OUT/steps.json (every round's best) and OUT/gains.json (--base's or the controller's gains, or
+with --into that file's, with the hop corner replaced). About 12-17 minutes on 2 cores with the
+census, 8 without.
 
     python scripts/hop_squat_search.py [--census FILE] [--census-box squat|squat_kav]
         [--census-seed 9] [--base GAINS.json] [--into GAINS.json] [--out out/hop_squat]

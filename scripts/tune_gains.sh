@@ -130,7 +130,7 @@ stage rc --gait run --only "$(python3 scripts/run_toe_clearance.py --free)" --co
 # unused states. About 25 minutes.
 python3 scripts/hop_squat_search.py --census-box squat_kav --census-seed 10 --base "$OUT/jb/gains.json" --into "$prev" --out "$OUT/hs"
 prev="$OUT/hs/gains.json"
-python3 scripts/walk_startup_search.py --start "$prev" --guard falls --out "$OUT/ws"
+python3 scripts/walk_startup_search.py --start "$prev" --guard falls --adopted --out "$OUT/ws"
 prev="$OUT/ws/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'

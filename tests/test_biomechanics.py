@@ -134,8 +134,9 @@ def test_stance_impulses_split_each_stance_at_its_middle():
 
 def test_the_run_brakes_then_propels():
     """A gait moving forwards at a steady speed brakes in the first half of each stance and
-    propels in the second (Cavagna et al. 1976 for human running). (The hop's opposite pattern,
-    a take-off pushing backwards, is a measurement the README reports, not an expectation.)"""
+    propels in the second (Cavagna et al. 1976 for human running). (The hop's pattern, which
+    pushed backwards at take-off until session 35 and brakes then propels since, is a
+    measurement the README reports, not an expectation.)"""
     run = validate(build("ml", "run"), "run", 8.0).summary()
     assert run["stance_impulse_first_half_Ns"] < 0 < run["stance_impulse_second_half_Ns"]
 
@@ -147,16 +148,16 @@ def test_the_run_brakes_then_propels():
                "the hop's corner and the walk's start-up corner (2026-12-06, session 35); -10.8 "
                "backwards, -1.6 unpushed: after the forward push the walk lands once at 1222 N, "
                "and the contact forces, sampled once per 4 ms control tick (2 ms physics steps), "
-               "probably miss part of that impact")),
+               "may miss part of that impact (a guess, not verified)")),
     pytest.param((6.0, -10.0, 0.2), id="held-10"), pytest.param((6.0, 10.0), id="blow+10")])
 def test_a_push_delivers_its_impulse(push):
     """Newton's second law across a push: the change of the walk's momentum between the
     stride before the push and the stride after it (mean speeds from the centre of mass), less
     the ground's horizontal impulse over the same time (from the recorded contact forces), is
     the push's impulse, whether its force is held 0.2 s or struck in one 4 ms tick. The same
-    estimate without a push reads -1.5 N s (the force is sampled once per tick): within 2.5 N s
-    of the 10 N s asked. A force held for one tick at impulse / 0.2 s would deliver 0.2 N s,
-    one held 0.2 s at impulse / 4 ms 500 N s."""
+    estimate without a push reads -1.5 to -1.6 N s (the force is sampled once per tick):
+    within 2.5 N s of the 10 N s asked. A force held for one tick at impulse / 0.2 s would
+    deliver 0.2 N s, one held 0.2 s at impulse / 4 ms 500 N s."""
     rec = rollout(build("ml", "walk"), 9.0, push=push, poses=False)
     _, mass, _, _ = body_constants()
     ground = np.cumsum(rec.grf_x.sum(axis=1)) * rec.dt

@@ -614,6 +614,8 @@ def test_gains_set_by_hand_are_a_link_of_the_chain(tmp_path):
     assert p.corner("alternating") == CONTROL.corner("alternating")
     assert replace(p, startup=CONTROL.startup) == CONTROL
     assert prov[-1]["part"] == ["startup.alternating"]
+    with pytest.raises(InputError, match="unknown gain"):
+        set_by_hand(GAINS_FILE, {"startup.alternating.no_such_gain": 1.0}, out, "bad")
 
 
 def test_guard_counts_only_a_guarded_gaits_excess_over_its_reference():

@@ -181,7 +181,8 @@ IN_FAMILY_SHORTFALL = {
     ("run", "walk", 2.0, K_FB): "a walk 5 CPG cycles after the change, no fall (3 before the "
                                 "hop's corner)",
     # jump -> hop fell all four ways from the jump corner's balance reference (session 32) to
-    # the hop's corner; over the change times 8-14 s it now reaches the hop in 8 of 28
+    # the hop's corner; over the change times 8-14 s it now passes in 8 of 28 (reaches the
+    # hop in 15)
     ("jump", "hop", 0.0, 0.0): "falls at 12.0 s, 4 s after the change (a hop from changes at "
                                "10-13 s)",
     ("jump", "hop", 0.0, K_FB): "falls at 12.5 s, 4.5 s after the change",

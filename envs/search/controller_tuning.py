@@ -798,10 +798,11 @@ def _r(x, nd: int = 4):
 
 def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, why: str) -> dict:
     """A link of a tuning chain that is not a search: ``start``'s gains with ``values``
-    ({"<corner>.<gain>" or a shared name: value}) set by hand, written to ``out`` with a
-    provenance entry (hand_set, what was set and why, and the SHA-256 of the values it started
-    from and ended with, as a search's entry has), for a search that needs a start outside
-    the basin the previous link ended in (scripts/tune_run_experiment.sh)."""
+    ({"<corner>.<gain>", "startup.<corner>.<gain>" or a shared name: value}) set by hand,
+    written to ``out`` with a provenance entry (hand_set, what was set and why, and the
+    SHA-256 of the values it started from and ended with, as a search's entry has), for a
+    search that needs a start outside the basin the previous link ended in
+    (scripts/tune_run_experiment.sh)."""
     from cpgbiped.cpg.io import write_json
 
     base, provenance = read_gains(start)
@@ -810,8 +811,8 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
         n.split(".")[-1] for n in names) + tuple(n for n in names if n.startswith(STARTUP))))}
     bad = [n for n in names if n not in known]
     if bad:
-        raise InputError(f"unknown gain {', '.join(map(repr, bad))}: use <corner>.<gain> or a "
-                         f"shared name")
+        raise InputError(f"unknown gain {', '.join(map(repr, bad))}: use <corner>.<gain>, "
+                         f"startup.<corner>.<gain> or a shared name")
     p = with_values(base, names, [values[n] for n in names])
     entry = {"part": sorted({n.rsplit(".", 1)[0] for n in names if "." in n}) or ["shared"],
              "hand_set": True, "set": {n: float(values[n]) for n in names}, "note": why,
