@@ -31,6 +31,7 @@ apex with the mean speed over the standing draws. About 3.5 minutes per 3000 dra
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -68,8 +69,10 @@ def write_body(out: Path, flexor: float, slope: float = -150.0) -> str:
     return str(d / "scene.xml")
 
 
+@functools.lru_cache(maxsize=4)
 def base_params(base: str | None):
-    """The gains the drawn hop corner goes into: the file ``base``, or the controller's own."""
+    """The gains the drawn hop corner goes into: the file ``base``, or the controller's own
+    (read once per process, not once per draw)."""
     from cpgbiped.envs.control.controller import CONTROL, read_gains
     return CONTROL if base is None else read_gains(base)[0]
 

@@ -63,8 +63,8 @@ RNG_SEED = 5
 # The provenance note of a chain's link (--into): what was found and how; why it was adopted
 # goes into the note of the link that adopts it.
 INTO_NOTE = ("the hop corner found by python scripts/hop_squat_search.py {args} (census draw "
-             "{draw}, the local search's random numbers default_rng(5)), scored on tuning CPG "
-             "states with the other gains of --base")
+             "{draw}, the local search's random numbers default_rng(%d)), scored on tuning CPG "
+             "states with the other gains of --base" % RNG_SEED)
 HOP_SEEDS_LOCAL = (1000, 1001, 1002, 1003)
 HOP_SEEDS_GUARDED = tuple(range(1000, 1008))
 RUN_SEEDS_GUARDED = (1000, 1001, 1002, 1003)

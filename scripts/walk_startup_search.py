@@ -97,14 +97,14 @@ def with_corner(base: dict, x_unit: np.ndarray) -> dict:
 
 
 def rollout_terms(job) -> tuple:
-    """(fell, peak pitch in the early window (rad), seconds in the air in it). A rollout stops
-    at a fall, and the seconds in the air are then its airborne share of the window up to the
-    fall times the window (the fall's 10 dominates such a score)."""
-    gains, gait, seed = job
+    """(fell, peak pitch in the early window (rad), seconds in the air in it) of job (params,
+    gait, seed). A rollout stops at a fall, and the seconds in the air are then its airborne
+    share of the window up to the fall times the window (the fall's 10 dominates such a
+    score)."""
+    params, gait, seed = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import params_from_dict
     from cpgbiped.envs.simulation.rollout import rollout
-    r = rollout(build("ml", gait, seed=seed), SECONDS, params_from_dict(gains), poses=False)
+    r = rollout(build("ml", gait, seed=seed), SECONDS, params, poses=False)
     m = r.t < EARLY_S
     air = float(np.mean(r.contact[m].sum(1) == 0) * EARLY_S)
     return r.fell_at is not None, float(np.max(np.abs(r.torso_pitch[m]))), air
@@ -112,14 +112,13 @@ def rollout_terms(job) -> tuple:
 
 def guard_terms(job) -> tuple:
     """(fell, passed its criteria) of a guarded preset over 2 s + GUARD_S."""
-    gains, gait, seed = job
+    params, gait, seed = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import params_from_dict
     from cpgbiped.envs.gaits.criteria import SETTLE_S
     from cpgbiped.envs.gaits.validate import measure_recording
     from cpgbiped.envs.simulation.rollout import rollout
     net = build("ml", gait, seed=seed)
-    rec = rollout(net, SETTLE_S + GUARD_S, params_from_dict(gains), poses=False)
+    rec = rollout(net, SETTLE_S + GUARD_S, params, poses=False)
     m = measure_recording(net, gait, rec, SETTLE_S).summary()
     return bool(m["fell"]), bool(m["passed"])
 
@@ -130,9 +129,13 @@ def falls_terms(job) -> tuple:
 
 
 def score(ex, gains: dict, guard_kind: str = "criteria") -> tuple:
-    walk = list(ex.map(rollout_terms, [(gains, "walk", s) for s in WALK_SEEDS], chunksize=4))
+    """(score, summary) of a gains dict; its parameters are parsed once and shipped to the
+    workers as they are."""
+    from cpgbiped.envs.control.controller import params_from_dict
+    params = params_from_dict(gains)
+    walk = list(ex.map(rollout_terms, [(params, "walk", s) for s in WALK_SEEDS], chunksize=4))
     guard = list(ex.map(guard_terms if guard_kind == "criteria" else falls_terms,
-                        [(gains, g, s) for g in ("run", "jump", "hop") for s in GUARD_SEEDS],
+                        [(params, g, s) for g in ("run", "jump", "hop") for s in GUARD_SEEDS],
                         chunksize=2))
     w = np.mean([10 * f + 5 * max(0.0, p - PITCH_FREE_RAD) + a for f, p, a in walk])
     gd = np.mean([10 * f + 3 * (not ok) for f, ok in guard])

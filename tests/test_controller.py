@@ -1,6 +1,8 @@
 """The one controller: the CPG's ankle drive, the features it measures from the CPG, and that
 it takes nothing but the CPG's signals and the body's sensors."""
 import inspect
+import json
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -165,12 +167,8 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
     """
     from dataclasses import replace
 
-    from cpgbiped.envs.gaits.validate import validate
-
-    import json
-    from pathlib import Path
-
     from cpgbiped.envs.control.controller import Corner
+    from cpgbiped.envs.gaits.validate import validate
 
     # the walk corner of stage w4, the start-up gains' walk corner until session 35 (its own
     # search then replaced it there): tests/data/walk_corner_w4.json
