@@ -80,7 +80,9 @@ TOE_UP_BEHIND_M = 0.1
 # with the row's CPG outputs from the sensors of the row before (a row's state is measured at
 # the end of its tick). R_GRF_X: the horizontal ground reaction force on each foot (N, > 0
 # forwards; the contact sensor's net force, which MuJoCo gives as the foot's force on the floor
-# in world axes, with its sign turned).
+# in world axes, with its sign turned), the mean over the tick's physics steps
+# (:func:`add_grf_x` after each step; the tick loops write it, :func:`record` does not): a
+# landing's impact lasts a few 2 ms steps, and one step sampled per tick aliases it.
 (R_T, R_CONTACT, R_FORCE, R_V, R_DRIVE, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX, R_COMZ,
  R_MODE, R_CTRL, R_POWER, R_FB, R_GRF_X) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37,
                                             45, 49)
@@ -407,7 +409,6 @@ def record(k, t_s, qpos, sens, xpos, act, ctrl, afrc, avel, ix, v, a, fb, S, rec
     for i in range(2):
         f = abs(sens[ix[IX_FORCE + i]])
         r[R_FORCE + i] = f
-        r[R_GRF_X + i] = -sens[ix[IX_FORCE + i] + SENSOR_FX_FROM_FZ]
         r[R_CONTACT + i] = 1.0 if f > CONTACT_N else 0.0
         r[R_MODE + i] = S[S_MODE + i]
     for c in range(4):
@@ -464,6 +465,24 @@ def tick(k, t_s, sched_v, sched_a, dt_s, P, S, qpos, qvel, sens, xpos, act, ctrl
 
 
 NO_FB = np.zeros(4)  # the feedback row of an open-loop rollout
+
+
+@njit(cache=True)
+def add_grf_x(sens, ix, acc):
+    """Add each foot's horizontal ground reaction force (N, > 0 forwards) at the physics step
+    just taken to ``acc`` (2,). MuJoCo computes the sensors in the step's forward pass, before
+    it integrates: the values are the forces that acted during that step."""
+    for i in range(2):
+        acc[i] -= sens[ix[IX_FORCE + i] + SENSOR_FX_FROM_FZ]
+
+
+@njit(cache=True)
+def write_grf_x(rec, k, acc, n_steps):
+    """Row k's R_GRF_X: the mean of ``acc`` over the tick's ``n_steps`` physics steps; then
+    clear ``acc`` for the next tick."""
+    for i in range(2):
+        rec[k, R_GRF_X + i] = acc[i] / n_steps
+        acc[i] = 0.0
 
 
 @njit(cache=True)

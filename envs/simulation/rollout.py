@@ -192,9 +192,11 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
         # Tick k records row k - 1 (the state after the last steps) and sets the controls of
         # tick k, in one compiled call (kernel.tick); the loop runs one extra tick for the
         # last row.
+        grf = np.zeros(2)  # the horizontal ground forces summed over a tick's steps
         for k in range(n_ticks + 1):
             status = tick(k)
             if k > 0:
+                kernel.write_grf_x(rec, k - 1, grf, CONTROL_EVERY)
                 if status == 2 or bad_qacc.number:
                     unstable = f"physics became unstable at t={d.time:.3f} s"
                     break
@@ -212,7 +214,9 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
             pushing = 0 <= k - push_tick < push_n  # impulse = force x duration
             if pushing:
                 d.xfrc_applied[torso_id, 0] = push_force
-            mujoco.mj_step(m, d, nstep=CONTROL_EVERY)
+            for _ in range(CONTROL_EVERY):
+                mujoco.mj_step(m, d)
+                kernel.add_grf_x(sens, ix, grf)
             if pushing:
                 d.xfrc_applied[torso_id, 0] = 0.0
     except mujoco.FatalError as e:
@@ -231,7 +235,7 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push_n, force, torso_id, rec,
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
     args = (d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl, d.actuator_force,
             d.actuator_velocity, ctrl.ix, ctrl.last_v, ctrl.last_a, rec, FALL_HEIGHT,
-            FALL_PITCH, push_tick, push_n, force, d.xfrc_applied, torso_id)
+            FALL_PITCH, push_tick, push_n, force, d.xfrc_applied, torso_id, np.zeros(2))
     k, n, fell = 0, 0, None
     sched = ctrl.sched
     while k <= n_ticks:
