@@ -335,20 +335,20 @@ def test_from_the_run_to_the_walk_the_open_loop_network_hops_and_feedback_undoes
 HOPF_SHORTFALL = {
     ("walk", "run", 0.0): "a run 9 CPG cycles after the change (4 asked), no fall; the "
                           "Hopf network alone is a run from the 8th",
-    ("walk", "run", 2.0): "falls at 10.2 s, as the ramp ends (since the walk's stance knee; "
+    ("walk", "run", 2.0): "falls at 10.3 s, as the ramp ends (since the walk's stance knee; "
                           "a run after 2 cycles before)",
-    # re-measured after the run's swing clearance (2026-12-05, session 34; the Hopf run's
-    # corner): run -> walk fell at 8.6 and 9.0 s before it, jump -> hop at 8.7 and 8.8 s,
-    # hop -> jump at 15.0 and 13.5 s
+    # re-measured after the hop's corner and the walk's start-up corner (2026-12-06, session
+    # 36): run -> walk fell at 8.5 and 9.5 s before it too; jump -> hop at 8.4 s, hop -> jump
+    # at 14.9 and 17.5 s (after the run's swing clearance, session 34: run -> walk 8.6 and 9.0
+    # s, jump -> hop 8.7 and 8.8 s, hop -> jump 15.0 and 13.5 s)
     ("run", "walk", 0.0): "falls at 8.5 s, 0.5 s after the change; the network's bursts "
                           "alternate from the change on: the body's failure",
-    ("run", "walk", 2.0): "falls at 9.5 s, during the ramp",
-    # the Hopf jump falls at 8.4 s without a change too (at 4.8 s before the jump corner's
-    # balance reference, 2026-12-05)
-    ("jump", "hop", 0.0): "falls at 8.4 s, as the Hopf jump does unchanged",
-    ("jump", "hop", 2.0): "falls at 8.4 s, as the Hopf jump does unchanged",
-    ("hop", "jump", 0.0): "falls at 14.9 s, 6.9 s after the change",
-    ("hop", "jump", 2.0): "falls at 17.5 s, 7.5 s after the ramp ends",
+    ("run", "walk", 2.0): "falls at 9.6 s, during the ramp",
+    # the Hopf jump falls at 6.5 s without a change too (tests/test_matrix.py)
+    ("jump", "hop", 0.0): "falls at 6.5 s, before the change, as the Hopf jump does unchanged",
+    ("jump", "hop", 2.0): "falls at 6.5 s, before the change, as the Hopf jump does unchanged",
+    ("hop", "jump", 0.0): "falls at 13.1 s, 5.1 s after the change",
+    ("hop", "jump", 2.0): "falls at 14.5 s, 4.5 s after the ramp ends",
 }
 
 
