@@ -160,8 +160,9 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
     so the double support of the Table 2 walk grows. Measured on the walk corner they were tuned
     with (stage w4, the start-up gains' walk corner until session 35;
     tests/data/walk_corner_w4.json): there the walk's double support is 0.067 without them and
-    0.124 with them. The committed walk corner (stages wp1, wp2) keeps the trailing foot down by
-    itself (0.103 without them, 0.108 with them), so it no longer shows what they do. (That both
+    0.131 with them (re-measured in session 36 with today's start-up corners; 0.124 before). The
+    committed walk corner (stages wp1, wp2) keeps the trailing foot down by itself (0.148
+    without them, 0.134 with them), so it no longer shows what they do. (That both
     at their neutral 0 give the rollouts of a gains file written before they existed, bit for
     bit, is checked by tests/test_feedback.py on its recorded rows.)
     """
