@@ -73,8 +73,9 @@ def main(argv=None) -> int:
     out = ["## Gait quality, Table 3 state (20 s after 2 s of settling)", "",
            "| preset | passes | speed m/s | Fr | stride s | λ/L (2.3·Fr^0.3) | duty | double "
            "support | flight | apex cm | ankle excursion ° | stride CV | trunk lean ° | "
-           "horizontal impulse N s: stance 1st / 2nd half, touches per step |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "horizontal impulse N s: stance 1st / 2nd half, touches per step | "
+           "peak vertical force, body weights (at stance fraction) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for g in gaits:
         s = res[g, "table3"]
         f = fails(g, "table3")
@@ -88,7 +89,8 @@ def main(argv=None) -> int:
             f"{_f(s.get('stride_cv'), 1, 100)}% | {_f(s.get('trunk_lean_deg'), 0)} | "
             f"{_f(s.get('stance_impulse_first_half_Ns'), 1)} / "
             f"{_f(s.get('stance_impulse_second_half_Ns'), 1)}, "
-            f"{_f(s.get('touch_impulse_per_step_Ns'), 1)} |")
+            f"{_f(s.get('touch_impulse_per_step_Ns'), 1)} | "
+            f"{_f(s.get('peak_vertical_grf_bw'), 1)} ({_f(s.get('peak_vertical_grf_at'))}) |")
     out += ["", "## The 13 test conditions", "",
             "| preset | passes every criterion | failing conditions (first failure) |",
             "|---|---|---|"]

@@ -178,3 +178,46 @@ def test_a_held_push_gives_the_same_rows_in_the_compiled_and_the_python_loop():
         a, b = (rollout(net, 3.0, push=(2.2, -6.0, 0.2), poses=p, feedback=K)
                 for p in (False, True))
         assert np.array_equal(a.com_x, b.com_x) and np.array_equal(a.ctrl, b.ctrl), K
+
+
+@pytest.mark.parametrize("gait", ["walk", "run", "jump", "hop"])
+def test_the_vertical_ground_force_carries_the_weight(gait):
+    """Newton's second law, vertically, on the whole body: over the window, the mean of the
+    feet's vertical ground reaction forces is the body's weight plus m times the change of the
+    centre of mass's vertical speed over the window's length, mean F_z / (m g) = 1 + dv_z /
+    (g T). Within 0.002 of it (each tick's force the mean over its two physics steps: measured
+    within 0.0001 in all four gaits; the force at one of the two steps, as the contact column
+    records it, misses by 0.0024-0.0042 in the walk, the jump and the hop)."""
+    v = validate(build("ml", gait), gait, 20.0)
+    rec = v.recording
+    _, mass, _, _ = body_constants()
+    sel = np.nonzero(rec.t >= v.settle_s)[0]
+    i0, i1 = sel[0], sel[-1]
+    vz = np.gradient(rec.com_z, rec.t)
+    expected = 1.0 + (vz[i1] - vz[i0]) / (G * (rec.t[i1] - rec.t[i0]))
+    assert rec.fell_at is None
+    assert rec.grf_z[sel].sum(axis=1).mean() / (mass * G) == pytest.approx(expected, abs=0.002)
+
+
+def test_vertical_force_peaks_by_hand():
+    """Hand-made contacts and vertical forces (dt 10 ms, weight 100 N). Left foot: a 10-tick
+    stance whose force rises to 300 N at its second tick (an impact, (1 + 0.5) / 10 = 0.15 of
+    the way) and holds 100 N after; right foot: a 10-tick stance with a 200 N peak at its
+    sixth tick (0.55), and, 60 ms later (a gap longer than the 30 ms closed), a 2-tick touch
+    at 900 N that is not a stance. Medians of two: a peak of 2.5 body weights at 0.35 of the
+    stance."""
+    from cpgbiped.envs.gaits.gait_metrics import vertical_force_peaks
+
+    c = np.zeros((40, 2), bool)
+    f = np.zeros((40, 2))
+    c[2:12, 0] = True
+    f[2:12, 0] = 100.0
+    f[3, 0] = 300.0
+    c[14:24, 1] = True
+    f[14:24, 1] = 50.0
+    f[19, 1] = 200.0
+    c[30:32, 1] = True
+    f[30:32, 1] = 900.0
+    peak, when = vertical_force_peaks(c, f, 0.01, 100.0)
+    assert peak == pytest.approx((3.0 + 2.0) / 2)
+    assert when == pytest.approx((0.15 + 0.55) / 2)

@@ -76,11 +76,11 @@ def test_force_arrows_only_in_contact(logged):
         assert len(rows) == len(on)
         shown = np.array([bool(r) for r in rows])
         assert np.array_equal(shown, on)
-        # Up, the measured normal force, and along x the horizontal one, at 0.5 m per body
-        # weight: the arrow is the ground reaction force.
+        # Up the vertical force and along x the horizontal one (each tick's mean over its
+        # physics steps), at 0.5 m per body weight: the arrow is the ground reaction force.
         weight = load_model().body_mass.sum() * 9.81
         lengths = np.array([r[0][2] for r in rows if r])
-        assert np.allclose(lengths, 0.5 * rec.force[on, i] / weight, rtol=1e-5, atol=1e-6)
+        assert np.allclose(lengths, 0.5 * rec.grf_z[on, i] / weight, rtol=1e-5, atol=1e-6)
         assert np.mean(lengths) > 0.1
         along_x = np.array([r[0][0] for r in rows if r])
         assert np.allclose(along_x, 0.5 * rec.grf_x[on, i] / weight, rtol=1e-5, atol=1e-6)

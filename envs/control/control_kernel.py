@@ -81,12 +81,14 @@ TOE_UP_BEHIND_M = 0.1
 # the end of its tick). R_GRF_X: the horizontal ground reaction force on each foot (N, > 0
 # forwards; the contact sensor's net force, which MuJoCo gives as the foot's force on the floor
 # in world axes, with its sign turned), the mean over the tick's physics steps
-# (:func:`add_grf_x` after each step; the tick loops write it, :func:`record` does not): a
+# (:func:`add_grf` after each step; the tick loops write it, :func:`record` does not): a
 # landing's impact lasts a few 2 ms steps, and one step sampled per tick aliases it.
+# R_GRF_Z: the vertical ground reaction force on each foot (N, > 0 up), averaged the same way
+# (R_FORCE, the normal force at the tick's last step, decides R_CONTACT as before).
 (R_T, R_CONTACT, R_FORCE, R_V, R_DRIVE, R_ACT, R_JOINTS, R_HEIGHT, R_PITCH, R_COMX, R_COMZ,
- R_MODE, R_CTRL, R_POWER, R_FB, R_GRF_X) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27, 29, 37,
-                                            45, 49)
-R_SIZE = 51
+ R_MODE, R_CTRL, R_POWER, R_FB, R_GRF_X, R_GRF_Z) = (0, 1, 3, 5, 9, 13, 17, 23, 24, 25, 26, 27,
+                                                     29, 37, 45, 49, 51)
+R_SIZE = 53
 SENSOR_FX_FROM_FZ = -2  # the contact sensor's force x lies two slots before its z (found, x y z)
 
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
@@ -468,20 +470,24 @@ NO_FB = np.zeros(4)  # the feedback row of an open-loop rollout
 
 
 @njit(cache=True)
-def add_grf_x(sens, ix, acc):
-    """Add each foot's horizontal ground reaction force (N, > 0 forwards) at the physics step
-    just taken to ``acc`` (2,). MuJoCo computes the sensors in the step's forward pass, before
-    it integrates: the values are the forces that acted during that step."""
+def add_grf(sens, ix, acc):
+    """Add each foot's ground reaction force at the physics step just taken to ``acc`` (4,):
+    horizontal (N, > 0 forwards) left, right, then vertical (N, > 0 up) left, right. MuJoCo
+    computes the sensors in the step's forward pass, before it integrates: the values are the
+    forces that acted during that step."""
     for i in range(2):
         acc[i] -= sens[ix[IX_FORCE + i] + SENSOR_FX_FROM_FZ]
+        acc[2 + i] -= sens[ix[IX_FORCE + i]]
 
 
 @njit(cache=True)
-def write_grf_x(rec, k, acc, n_steps):
-    """Row k's R_GRF_X: the mean of ``acc`` over the tick's ``n_steps`` physics steps; then
-    clear ``acc`` for the next tick."""
+def write_grf(rec, k, acc, n_steps):
+    """Row k's R_GRF_X and R_GRF_Z: the means of ``acc`` over the tick's ``n_steps`` physics
+    steps; then clear ``acc`` for the next tick."""
     for i in range(2):
         rec[k, R_GRF_X + i] = acc[i] / n_steps
+        rec[k, R_GRF_Z + i] = acc[2 + i] / n_steps
+    for i in range(4):
         acc[i] = 0.0
 
 

@@ -237,6 +237,11 @@ class Biomechanics:
                             the horizontal impulse of the brief touches outside those stances
                             (a swinging foot's scuff or toe drag) per stance counted (N s,
                             < 0: they brake the body)
+    peak_vertical_grf_bw, peak_vertical_grf_at
+                            median over the stances of both feet of the largest vertical ground
+                            reaction force on the foot (body weights), and of where in the
+                            stance it came (fraction, 0 touchdown; :func:`vertical_force_peaks`):
+                            near 0.1 an impact, near the middle a spring's push
     """
 
     froude: float
@@ -253,6 +258,8 @@ class Biomechanics:
     stance_impulse_first_half_Ns: float = float("nan")
     stance_impulse_second_half_Ns: float = float("nan")
     touch_impulse_per_step_Ns: float = float("nan")
+    peak_vertical_grf_bw: float = float("nan")
+    peak_vertical_grf_at: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -270,37 +277,67 @@ def apex_height(com_z: np.ndarray, flight: np.ndarray) -> float:
     return float(np.median(rises)) if rises else 0.0
 
 
-def stance_impulses(contact: np.ndarray, grf_x: np.ndarray, dt: float,
-                    min_phase_s: float = MIN_PHASE_S) -> tuple[float, float, float]:
-    """(first half, second half, touches): the median over the complete stances of both feet
-    of the impulse of ``grf_x`` (T, 2; N) on that foot in the first and in the second half of
-    the stance's ticks (N s), and the impulse of the brief touches left out (below), summed
-    over the window and divided by the number of stances counted (N s per step). A stance
-    here is a run of raw ``contact`` (T, 2) with its gaps shorter than ``min_phase_s``
-    closed, so that every tick that carries a force belongs to a stance (a touchdown's first
-    bounce too, which :func:`debounce` would drop, and with it the landing's braking); a stance cut by the window's ends is not counted, nor a brief touch
-    shorter than half the 75th percentile of the stances' durations (a swinging foot's scuff,
-    which carries no weight)."""
+def stances(contact: np.ndarray, dt: float, min_phase_s: float = MIN_PHASE_S
+             ) -> tuple[list[tuple[int, int, int]], list[tuple[int, int, int]]]:
+    """(stances, touches): the complete stances of both feet as (foot, start, end) tick
+    ranges, and the brief touches left out. A stance here is a run of raw ``contact`` (T, 2)
+    with its gaps shorter than ``min_phase_s`` closed, so that every tick that carries a
+    force belongs to a stance (a touchdown's first bounce too, which :func:`debounce` would
+    drop, and with it the landing's braking); a stance cut by the window's ends is not
+    counted; a touch is a contact shorter than half the 75th percentile of the stances'
+    durations (a swinging foot's scuff, which carries no weight)."""
     n_min = max(1, int(round(min_phase_s / dt))) if dt > 0 else 1
-    stances = []
+    found = []
     for i in range(2):
         c = np.asarray(contact[:, i], bool).copy()
         for a, b in runs(~c):
             if a > 0 and b < len(c) and b - a < n_min:
                 c[a:b] = True
-        stances += [(i, a, b) for a, b in runs(c) if 0 < a and b < len(c) and b - a >= 2]
-    if not stances:
+        found += [(i, a, b) for a, b in runs(c) if 0 < a and b < len(c) and b - a >= 2]
+    if not found:
+        return [], []
+    shortest = 0.5 * np.percentile([b - a for _, a, b in found], 75)
+    return ([s for s in found if s[2] - s[1] >= shortest],
+            [s for s in found if s[2] - s[1] < shortest])
+
+
+def stance_impulses(contact: np.ndarray, grf_x: np.ndarray, dt: float,
+                    min_phase_s: float = MIN_PHASE_S) -> tuple[float, float, float]:
+    """(first half, second half, touches): the median over the complete stances of both feet
+    (:func:`stances`) of the impulse of ``grf_x`` (T, 2; N) on that foot in the first and in
+    the second half of the stance's ticks (N s), and the impulse of the brief touches, summed
+    over the window and divided by the number of stances counted (N s per step)."""
+    full, brief = stances(contact, dt, min_phase_s)
+    if not full:
         return float("nan"), float("nan"), float("nan")
-    shortest = 0.5 * np.percentile([b - a for _, a, b in stances], 75)
-    first, second, touches = [], [], 0.0
-    for i, a, b in stances:
-        if b - a >= shortest:
-            mid = a + (b - a) // 2
-            first.append(float(grf_x[a:mid, i].sum() * dt))
-            second.append(float(grf_x[mid:b, i].sum() * dt))
-        else:
-            touches += float(grf_x[a:b, i].sum() * dt)
+    first, second = [], []
+    for i, a, b in full:
+        mid = a + (b - a) // 2
+        first.append(float(grf_x[a:mid, i].sum() * dt))
+        second.append(float(grf_x[mid:b, i].sum() * dt))
+    touches = sum(float(grf_x[a:b, i].sum() * dt) for i, a, b in brief)
     return float(np.median(first)), float(np.median(second)), touches / len(first)
+
+
+def vertical_force_peaks(contact: np.ndarray, grf_z: np.ndarray, dt: float, weight_n: float,
+                         min_phase_s: float = MIN_PHASE_S) -> tuple[float, float]:
+    """(peak, when): the median over the complete stances of both feet (:func:`stances`) of
+    the largest vertical ground reaction force on the foot, in body weights (``grf_z`` (T, 2)
+    N, > 0 up, over ``weight_n``), and of where in its stance it came (0 touchdown, 1 lift-off).
+    Human references: walking 1.1-1.3 body weights in two humps near 0.25 and 0.75 of the
+    stance, a heel-strike transient below them; running 2-3 body weights near mid-stance, which
+    the spring-mass model puts at pi / (4 duty) for a half-sine force (Alexander 1989), above
+    an impact transient of 1.5-2 near 0.1 (Cavanagh & Lafortune 1980; Keller et al. 1996)."""
+    full, _ = stances(contact, dt, min_phase_s)
+    if not full or not weight_n > 0:
+        return float("nan"), float("nan")
+    peak, when = [], []
+    for i, a, b in full:
+        seg = np.asarray(grf_z[a:b, i], float)
+        k = int(np.argmax(seg))
+        peak.append(float(seg[k]) / weight_n)
+        when.append((k + 0.5) / (b - a))
+    return float(np.median(peak)), float(np.median(when))
 
 
 def stride_regularity(touchdowns: dict) -> tuple[float, float]:
@@ -320,14 +357,16 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
                  leg_length_m: float, mass_kg: float, settle_s: float = 0.0,
                  min_phase_s: float = MIN_PHASE_S,
                  pitch: np.ndarray | None = None,
-                 grf_x: np.ndarray | None = None) -> Biomechanics:
+                 grf_x: np.ndarray | None = None,
+                 grf_z: np.ndarray | None = None) -> Biomechanics:
     """Biomechanics of a rollout (see :class:`Biomechanics`).
 
     power (T, n_act) W per actuator; leg_joint (n_act,) in {"hip", "knee", "ankle"} and
     leg_of (n_act,) in {0 (left), 1 (right)}: where each actuator acts. ``m``: the contact
     metrics of the same window (stride period, touchdowns, speed). pitch (T,): torso pitch
     (rad, > 0 forward), for the trunk lean. grf_x (T, 2): the horizontal ground reaction
-    force on each foot (N, > 0 forwards), for the stance impulses."""
+    force on each foot (N, > 0 forwards), for the stance impulses; grf_z (T, 2) the vertical
+    one (N, > 0 up), for the peaks."""
     t = np.asarray(t, float)
     sel = t >= settle_s
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
@@ -354,6 +393,9 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
     imp = (stance_impulses(np.asarray(contact, bool)[sel], np.asarray(grf_x, float)[sel], dt,
                            min_phase_s)
            if grf_x is not None and len(grf_x) == len(t) else (float("nan"),) * 3)
+    vz = (vertical_force_peaks(np.asarray(contact, bool)[sel], np.asarray(grf_z, float)[sel], dt,
+                               mass_kg * G, min_phase_s)
+          if grf_z is not None and len(grf_z) == len(t) else (float("nan"),) * 2)
     return Biomechanics(
         froude=v * v / (G * leg_length_m), stride_length_m=stride,
         relative_stride_length=stride / leg_length_m, positive_work_J=work,
@@ -365,4 +407,5 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         trunk_lean_deg=(float(np.degrees(np.mean(np.asarray(pitch, float)[sel])))
                         if pitch is not None and sel.any() else float("nan")),
         stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1],
-        touch_impulse_per_step_Ns=imp[2])
+        touch_impulse_per_step_Ns=imp[2], peak_vertical_grf_bw=vz[0],
+        peak_vertical_grf_at=vz[1])

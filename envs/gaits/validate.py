@@ -115,7 +115,8 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
     bio = biomechanics(rec.t[sel], rec.contact[sel], rec.com_x[sel], rec.com_z[sel],
                        rec.power[sel], joint, side, m, leg, mass, settle_s,
                        pitch=rec.torso_pitch[sel],
-                       grf_x=rec.grf_x[sel] if len(rec.grf_x) == len(rec.t) else None)
+                       grf_x=rec.grf_x[sel] if len(rec.grf_x) == len(rec.t) else None,
+                       grf_z=rec.grf_z[sel] if len(rec.grf_z) == len(rec.t) else None)
     return Validation(network, gait, rec, m, cpg_name, settle_s, ankle_drive, bio)
 
 

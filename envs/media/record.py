@@ -8,9 +8,11 @@ Entities, per rollout under ``/<name>`` (e.g. ``/walk``):
   feet/left, feet/right               StateChange "stance"/"swing" at each debounced touchdown
                                       and lift-off: the footfall diagram, one lane per foot
   contacts                            debounced foot contact (0/1), series left, right
-  force                               normal ground reaction force (N), series left, right
-  force_x                             horizontal ground reaction force (N, > 0 forwards),
-                                      series left, right
+  force                               normal ground reaction force at the tick's last physics
+                                      step (N; the one that decides contact), series left, right
+  force_x, force_z                    horizontal (N, > 0 forwards) and vertical (N, > 0 up)
+                                      ground reaction force, each tick's mean over its physics
+                                      steps (the arrows' too), series left, right
   cpg                                 the four CPG cell outputs, series LF, RF, LE, RE
   activation                          ankle muscle activations, series LF, RF, LE, RE
   joints                              hip, knee, ankle angles (rad), series <leg>_<joint>
@@ -115,7 +117,9 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
             (("feedback", CELLS, rec.feedback, CELL_COLORS),)
             if rec.feedback_gain > 0 and len(rec.feedback) == len(t) else ()) + (
             (("force_x", LEGS, rec.grf_x, [FOOT_COLORS[leg] for leg in LEGS]),)
-            if len(rec.grf_x) == len(t) else ()):
+            if len(rec.grf_x) == len(t) else ()) + (
+            (("force_z", LEGS, rec.grf_z, [FOOT_COLORS[leg] for leg in LEGS]),)
+            if len(rec.grf_z) == len(t) else ()):
         rs.log(f"/{name}/{path}", rr.SeriesLines(names=list(names), colors=list(colors)),
                static=True)
         _columns(rs, f"/{name}/{path}", t, x)
@@ -142,7 +146,8 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
         record_body.log_static(rs, world, _static_entities(rec.xml_path))
         record_body.log_poses(rs, world, model, t, pose)
         weight = float(model.body_mass.sum() * -model.opt.gravity[2])
-        record_body.log_forces(rs, world, t, _soles(model, pose), contact, rec.force, weight,
+        vertical = rec.grf_z if len(rec.grf_z) == len(t) else rec.force
+        record_body.log_forces(rs, world, t, _soles(model, pose), contact, vertical, weight,
                                rec.grf_x if len(rec.grf_x) == len(t) else None)
         com = np.stack([rec.com_x, np.zeros_like(rec.com_x), rec.com_z], axis=1)
         record_body.log_com(rs, world, t, com)

@@ -58,7 +58,9 @@ class Recording:
     feedback: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))  # (T, 4) per cell
     feedback_gain: float = 0.0  # K of cpg.feedback (0: open loop)
     grf_x: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (T, 2) horizontal
-    # ground reaction force on each foot (N, > 0 forwards)
+    # ground reaction force on each foot (N, > 0 forwards), the mean over the tick's steps
+    grf_z: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (T, 2) vertical
+    # ground reaction force on each foot (N, > 0 up), the mean over the tick's steps
 
 
 def window(rec: Recording, t0: float, t1: float | None = None) -> Recording:
@@ -192,11 +194,11 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
         # Tick k records row k - 1 (the state after the last steps) and sets the controls of
         # tick k, in one compiled call (kernel.tick); the loop runs one extra tick for the
         # last row.
-        grf = np.zeros(2)  # the horizontal ground forces summed over a tick's steps
+        grf = np.zeros(4)  # the ground forces (x, x, z, z) summed over a tick's steps
         for k in range(n_ticks + 1):
             status = tick(k)
             if k > 0:
-                kernel.write_grf_x(rec, k - 1, grf, CONTROL_EVERY)
+                kernel.write_grf(rec, k - 1, grf, CONTROL_EVERY)
                 if status == 2 or bad_qacc.number:
                     unstable = f"physics became unstable at t={d.time:.3f} s"
                     break
@@ -216,7 +218,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
                 d.xfrc_applied[torso_id, 0] = push_force
             for _ in range(CONTROL_EVERY):
                 mujoco.mj_step(m, d)
-                kernel.add_grf_x(sens, ix, grf)
+                kernel.add_grf(sens, ix, grf)
             if pushing:
                 d.xfrc_applied[torso_id, 0] = 0.0
     except mujoco.FatalError as e:
@@ -235,7 +237,7 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push_n, force, torso_id, rec,
     bad_qacc = d.warning[mujoco.mjtWarning.mjWARN_BADQACC]
     args = (d.qpos, d.qvel, d.sensordata, d.xpos, d.act, d.ctrl, d.actuator_force,
             d.actuator_velocity, ctrl.ix, ctrl.last_v, ctrl.last_a, rec, FALL_HEIGHT,
-            FALL_PITCH, push_tick, push_n, force, d.xfrc_applied, torso_id, np.zeros(2))
+            FALL_PITCH, push_tick, push_n, force, d.xfrc_applied, torso_id, np.zeros(4))
     k, n, fell = 0, 0, None
     sched = ctrl.sched
     while k <= n_ticks:
@@ -272,4 +274,5 @@ def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path,
                      col(K.R_DRIVE, 4), col(K.R_ACT, 4), col(K.R_JOINTS, 6), col(K.R_HEIGHT),
                      col(K.R_PITCH), col(K.R_COMX), col(K.R_COMZ), col(K.R_MODE, 2),
                      col(K.R_CTRL, 8), col(K.R_POWER, 8), dt * CONTROL_EVERY, dt, fell, unstable,
-                     qpos, pose, str(xml_path), col(K.R_FB, 4), gain, col(K.R_GRF_X, 2))
+                     qpos, pose, str(xml_path), col(K.R_FB, 4), gain, col(K.R_GRF_X, 2),
+                     col(K.R_GRF_Z, 2))

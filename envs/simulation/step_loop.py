@@ -42,14 +42,14 @@ _mj_step = _library()
 def _steps(m_addr, d_addr, k, control_every, t_s, dt_s, push_tick, push_n, push_force, xfrc,
            torso_id, sens, ix, grf):
     """Tick k's physics steps, with the push's force during them when k is one of the push's
-    ``push_n`` ticks from ``push_tick``, each step's horizontal ground forces added to ``grf``;
+    ``push_n`` ticks from ``push_tick``, each step's ground forces added to ``grf``;
     returns MjData.time advanced by ``dt_s`` per step."""
     pushing = 0 <= k - push_tick < push_n  # never with no push (push_n 0)
     if pushing:
         xfrc[torso_id, 0] = push_force
     for _ in range(control_every):
         _mj_step(m_addr, d_addr)
-        kernel.add_grf_x(sens, ix, grf)
+        kernel.add_grf(sens, ix, grf)
         t_s += dt_s
     if pushing:
         xfrc[torso_id, 0] = 0.0
@@ -64,13 +64,13 @@ def run_ticks(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_s, sv, 
     physics; tick n_ticks only records). It returns after the tick whose row is fallen
     (status 1, its steps done) or non-finite (status 2, before its steps). ``t_s``: MjData.time at tick k0, advanced here by ``dt_s`` per physics step
     as MuJoCo advances it (the same sums). Returns (next tick, status of the last recorded row:
-    0 fine, 1 fallen, 2 non-finite). ``grf`` (2,): the horizontal ground forces summed over the
+    0 fine, 1 fallen, 2 non-finite). ``grf`` (4,): the ground forces (``kernel.add_grf``) summed over the
     steps of tick k0 - 1 (zeros when k0 = 0), carried between calls."""
     for k in range(k0, k_end):
         status = kernel.tick(k, t_s, sv, sa, sdt, P, S, qpos, qvel, sens, xpos, act, ctrl,
                              afrc, avel, ix, v, a, rec, fall_height, fall_pitch)
         if k > 0:
-            kernel.write_grf_x(rec, k - 1, grf, control_every)
+            kernel.write_grf(rec, k - 1, grf, control_every)
         if k > 0 and status == 2:
             return k + 1, status
         if k == n_ticks:
@@ -96,7 +96,7 @@ def run_ticks_closed(m_addr, d_addr, k0, k_end, n_ticks, control_every, t_s, dt_
                                     qvel, sens, xpos, act, ctrl, afrc, avel, ix, v, a, rec,
                                     fall_height, fall_pitch)
         if k > 0:
-            kernel.write_grf_x(rec, k - 1, grf, control_every)
+            kernel.write_grf(rec, k - 1, grf, control_every)
         if k > 0 and status == 2:
             return k + 1, status
         if k == n_ticks:
