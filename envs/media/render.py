@@ -291,9 +291,11 @@ def gait_cycle(rec, touchdowns, leg: int, signals: np.ndarray, points: int = 101
 
 def gait_cycle_picture(rec, metrics, path: str | Path, title: str = "",
                        weight_n: float | None = None) -> Path:
-    """Hip, knee and ankle angles (deg) and the vertical ground reaction force (body weights)
-    of each leg against 0-100% of its gait cycle (touchdown to touchdown), mean +- s.d. over
-    the strides of the measured window; the biomechanics convention (SCONE's gait analysis)."""
+    """Hip, knee and ankle angles (deg) and the vertical and horizontal ground reaction forces
+    (body weights; each tick's mean over its physics steps, ``Recording.grf_z`` and ``grf_x``,
+    or the normal force at the tick's last step for a recording without them) of each leg
+    against 0-100% of its gait cycle (touchdown to touchdown), mean +- s.d. over the strides of
+    the measured window; the biomechanics convention (SCONE's gait analysis)."""
     from cpgbiped.cpg.plots import _plt
 
     from cpgbiped.envs.simulation.biped import body_constants
@@ -301,15 +303,20 @@ def gait_cycle_picture(rec, metrics, path: str | Path, title: str = "",
     plt = _plt()
     if weight_n is None:
         weight_n = body_constants(rec.xml_path)[1] * 9.81
-    fig, axes = plt.subplots(1, 4, figsize=(13, 3.2))
+    fig, axes = plt.subplots(1, 5, figsize=(16, 3.2))
     pct = np.linspace(0, 100, 101)
-    names = ("hip (deg)", "knee (deg)", "ankle (deg)", "vertical GRF (body weights)")
+    names = ("hip (deg)", "knee (deg)", "ankle (deg)", "vertical GRF (body weights)",
+             "horizontal GRF (body weights, > 0 forwards)")
+    n = len(rec.t)
+    vertical = rec.grf_z if len(rec.grf_z) == n else rec.force
+    horizontal = rec.grf_x if len(rec.grf_x) == n else np.full((n, 2), np.nan)
     for leg, (name, color) in enumerate((("left", "tab:blue"), ("right", "tab:orange"))):
         td = metrics.touchdowns[name]
         if len(td) < 3:
             continue
         sig = np.concatenate([np.degrees(rec.joints[:, 3 * leg:3 * leg + 3]),
-                              rec.force[:, leg:leg + 1] / weight_n], axis=1)
+                              vertical[:, leg:leg + 1] / weight_n,
+                              horizontal[:, leg:leg + 1] / weight_n], axis=1)
         cyc = gait_cycle(rec, td, leg, sig)
         mean, sd = cyc.mean(axis=0), cyc.std(axis=0)
         for j, ax in enumerate(axes):
