@@ -89,6 +89,20 @@ def test_force_arrows_only_in_contact(logged):
     assert set(s[0] for s in states) == {"stance", "swing"}
 
 
+def test_ground_force_series_are_the_recorded_columns(logged):
+    """/walk/force_x and /walk/force_z carry the rollout's horizontal and vertical ground
+    reaction forces (each tick's mean over its physics steps), left and right, at every tick:
+    the same numbers as Recording.grf_x and grf_z of the same deterministic rollout."""
+    rrd, v = logged
+    rec = v.recording
+    for entity, want in (("/walk/force_x", rec.grf_x), ("/walk/force_z", rec.grf_z)):
+        t, rows = read_component(rrd, entity, "Scalars:scalars")
+        assert len(t) == len(rec.t) and np.allclose(t, rec.t, atol=1e-9), entity
+        got = np.array([r for r in rows], dtype=float).reshape(len(rows), -1)
+        assert got.shape == want.shape and np.allclose(got, want), entity
+    assert rec.grf_z.max() > 100.0  # the feet carry the 206 N body: not an empty series
+
+
 def test_blueprint_views_use_the_logged_paths():
     rec = validate(build("ml", "walk"), "walk", 2.0, settle_s=0.0)
     bp = blueprint({"walk": (rec.recording, rec.metrics)}, {"walk": "walk.mp4"})

@@ -339,7 +339,7 @@ HOPF_SHORTFALL = {
                           "a run after 2 cycles before)",
     # re-measured after the hop's corner and the walk's start-up corner (2026-12-06, session
     # 36): run -> walk fell at 8.5 and 9.5 s before it too; jump -> hop at 8.4 s, hop -> jump
-    # at 14.9 and 17.5 s (after the run's swing clearance, session 34: run -> walk 8.6 and 9.0
+    # at 14.9 and 17.5 s (before the run's swing clearance, session 34: run -> walk 8.6 and 9.0
     # s, jump -> hop 8.7 and 8.8 s, hop -> jump 15.0 and 13.5 s)
     ("run", "walk", 0.0): "falls at 8.5 s, 0.5 s after the change; the network's bursts "
                           "alternate from the change on: the body's failure",

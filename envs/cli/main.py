@@ -1094,8 +1094,8 @@ def build_parser() -> argparse.ArgumentParser:
         signals runs below unless --no-signals. Also writes FILE_chrono.png (a
         chronophotograph: the body's poses over the last two strides on one picture, feet on
         the ground drawn thick, footprints marked), FILE_gait.png (footfall diagram),
-        FILE_cycle.png (joint angles and vertical ground reaction force over the gait cycle,
-        mean +- s.d. over strides) and FILE_signals.png beside the video.""")
+        FILE_cycle.png (joint angles and vertical and horizontal ground reaction forces over
+        the gait cycle, mean +- s.d. over strides) and FILE_signals.png beside the video.""")
     rollout_args(sp)
     sp.add_argument("--width", type=count_arg(1), default=640)
     sp.add_argument("--height", type=count_arg(1), default=480)
@@ -1381,7 +1381,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "that --gait and --search select; a name may be one corner's "
                          "(synchronous.theta0) or all of it (synchronous.*), so that "
                          "--gait walk,jump --only 'synchronous.*' searches the jump's corner "
-                         "scored on both gaits; land_yield, x_bal, lean_knee, toe_up, calf_stretch, lift_abort and restart_v are "
+                         "scored on both gaits; land_yield, x_bal, lean_knee, toe_up, lift_abort and restart_v are "
                          "searched only when named here; startup.<corner>.<gain> or startup.<corner>.* searches "
                          "the start-up gains that hand over to the corners in the first "
                          "seconds (every gait starts on them)")

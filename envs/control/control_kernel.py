@@ -30,15 +30,15 @@ SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
-           "land_yield", "x_bal", "lean_knee", "toe_up", "calf_stretch")
+           "land_yield", "x_bal", "lean_knee", "toe_up")
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
-                 "lean_knee": 0.0, "toe_up": 0.0, "calf_stretch": 0.0}
+                 "lean_knee": 0.0, "toe_up": 0.0}
 ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
-ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up", "calf_stretch")
+ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -50,8 +50,7 @@ P_SIZE_STARTUP = P_SIZE + 4 * len(BLENDED) + 1
 (IX_ROOTY_Q, IX_ROOTY_V, IX_HIP_Q, IX_HIP_V, IX_KNEE_Q, IX_KNEE_V, IX_FORCE, IX_COM, IX_COMVEL,
  IX_FOOT, IX_TORSO, IX_BODY_FLOOR, IX_N_BODY_FLOOR, IX_JOINTS) = (
     0, 1, 2, 4, 6, 8, 10, 12, 13, 14, 16, 17, 18, 19)  # pairs are (left, right); joints: 6
-IX_ANKLE_V = 25  # pair: the ankles' qvel addresses
-IX_SIZE = 27
+IX_SIZE = 25
 
 # Controller state layout (pairs are left, right).
 # S_LAST_GROUND: the last time (s) each foot carried CONTACT_N; slots 2-3 are unused.
@@ -206,11 +205,10 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                     G[n] += w01 * (nu_ac - nu) * (P[P_SIZE + 4 * n + 1] - P[m])
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee, toe_up,
-     calf_stretch) = (
+     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee, toe_up) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
         G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24], G[25],
-        G[26], G[27], G[28])
+        G[26], G[27])
     push_off = max(0.0, push_off)
     knee_hold = _clip01(knee_hold)
     land_yield = _clip01(land_yield)
@@ -334,13 +332,6 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                     u[2 + i] = min(u[2 + i] + b, 1.0)
                 else:
                     u[i] = min(u[i] - b, 1.0)
-        if calf_stretch > 0.0:  # early stance: the calf resists the loaded ankle's dorsiflexion
-            for i in range(2):
-                if mode[i] == MODE_SUPPORT:
-                    rate = qvel[ix[IX_ANKLE_V + i]]  # > 0 dorsiflexing
-                    if rate > 0.0:
-                        u[2 + i] = min(u[2 + i] + calf_stretch * rate
-                                       * _clip01((foot_x[i] - hip_x) / 0.05 + 1.0), 1.0)
         ref_x = sup_x
     else:
         ref_x = com_x

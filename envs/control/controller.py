@@ -69,13 +69,7 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    (x_foot the foot's centre; kernel.TOE_UP_BEHIND_M = 0.1 m): the swing's dorsiflexion that
    clears the toes, as the human tibialis anterior does (a tucked shank otherwise points the
    passive foot's toes at the floor, and the run stubbed them); it has faded before the
-   landing. A support leg whose ankle dorsiflexes adds calf_stretch (blended, activation per
-   rad/s, neutral 0) times that rate to its extensor while its foot is ahead of the hip or
-   less than 5 cm behind it (early stance),
-       u_ext,i += calf_stretch max(0, dq_ankle,i/dt) clip((x_foot,i - x_hip) / 0.05 m + 1, 0, 1):
-   a stretch reflex of the calf (the soleus's feedback in Geyer & Herr's reflex walker) that
-   lowers the heel of a foot landing on its toes instead of letting it slap down (the walk:
-   README "The vertical ground forces"). ``--no-ankle-drive``
+   landing. ``--no-ankle-drive``
    sets ankle_gain = 0 (the reflexes stay).
 4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
    tau_torso = kp_t (pitch_d' - pitch) - kd_t pitch_rate, with the pitch target
@@ -181,7 +175,6 @@ class Corner:
     x_bal: float  # m: the balance reflex's reference, this far ahead of the support feet's centre
     lean_knee: float  # rad of trunk pitch target per rad of mean knee flexion
     toe_up: float  # swing: dorsiflexor activation added while the foot is behind the hip
-    calf_stretch: float  # stance: extensor activation per rad/s of ankle dorsiflexion (early)
 
 
 @dataclass(frozen=True)
@@ -416,7 +409,6 @@ def kernel_index(m) -> np.ndarray:
     for i, leg in enumerate(("left", "right")):
         ix[kernel.IX_HIP_Q + i], ix[kernel.IX_HIP_V + i] = jq(f"{leg}_hip"), jv(f"{leg}_hip")
         ix[kernel.IX_KNEE_Q + i], ix[kernel.IX_KNEE_V + i] = jq(f"{leg}_knee"), jv(f"{leg}_knee")
-        ix[kernel.IX_ANKLE_V + i] = jv(f"{leg}_ankle")
         ix[kernel.IX_FORCE + i] = sa(f"{leg}_foot_contact") + 3  # found, then force x y z: normal
         ix[kernel.IX_FOOT + i] = named("body", f"{leg}_foot").id
         for j, name in enumerate(("hip", "knee", "ankle")):

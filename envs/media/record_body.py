@@ -125,8 +125,9 @@ def log_poses(rs, root: str, model: mujoco.MjModel, t: np.ndarray, pose: np.ndar
 def log_forces(rs, root: str, t: np.ndarray, feet: dict, contact: np.ndarray,
                force: np.ndarray, weight_n: float, force_x: np.ndarray | None = None) -> None:
     """Ground reaction force arrows while each foot is in contact, 0.5 m per body weight: the
-    normal force ``force`` (T, k; N) up and, when given, the horizontal force ``force_x`` (T, k;
-    N, > 0 forwards) along x, so that an arrow leaning back is a foot pushing the body back.
+    vertical force ``force`` (T, k; N, > 0 up; the recorder passes each tick's mean over its
+    physics steps) up and, when given, the horizontal force ``force_x`` (T, k; N, > 0
+    forwards) along x, so that an arrow leaning back is a foot pushing the body back.
     feet maps a name to its (T, 3) sole position; contact (T, k) bool, in the same order."""
     import rerun as rr
 
