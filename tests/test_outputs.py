@@ -39,6 +39,19 @@ def test_validate_json_keys(capsys):
     assert (s["network"], s["preset"], s["gait"], s["ankle_drive"]) == ("ml", "walk", "walk", True)
 
 
+def test_validate_text_prints_the_json_s_biomechanics(capsys):
+    """Without --json, validate prints the biomechanics and the ground forces under its table:
+    the same numbers as --json gives for the same (deterministic) rollout."""
+    assert main(["validate", "--gait", "walk", "--seconds", "6", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert main(["validate", "--gait", "walk", "--seconds", "6"]) == 0
+    text = capsys.readouterr().out
+    assert f"Fr {s['froude']:.3f}" in text
+    assert (f"peak vertical force {s['peak_vertical_grf_bw']:.1f} body weights at "
+            f"{s['peak_vertical_grf_at']:.2f} of the stance") in text
+    assert f"horizontal impulse {s['stance_impulse_first_half_Ns']:.1f} / " in text
+
+
 def test_validate_separates_the_driver_from_the_target(capsys):
     """--network/--preset choose what drives the body, --gait only what the verdict checks."""
     assert main(["validate", "--gait", "walk", "--network", "hopf", "--preset", "jump",

@@ -689,7 +689,7 @@ def _input_error(msg):
 
 def cmd_validate(a) -> int:
     from cpgbiped.cpg import io
-    from cpgbiped.envs.gaits.validate import metrics_table
+    from cpgbiped.envs.gaits.validate import biomechanics_text, metrics_table
 
     out_file(a.rrd, "--rrd", ".rrd")
     v, label = _validation(a)
@@ -707,6 +707,7 @@ def cmd_validate(a) -> int:
               + (f", friction x{a.friction_scale:g}" if a.friction_scale != 1 else "")
               + (", CPG ankle drive removed" if a.no_ankle_drive else ""))
         print(metrics_table({a.gait: s}))
+        print(biomechanics_text(s))
         for f in s["failures"]:
             print(f"  not met: {f}")
         if s["unstable"]:

@@ -120,6 +120,32 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
     return Validation(network, gait, rec, m, cpg_name, settle_s, ankle_drive, bio)
 
 
+def biomechanics_text(s: dict) -> str:
+    """The biomechanics of one ``Validation.summary()`` as two lines of text (what `validate`
+    prints under its table; the same numbers as ``--json``): speed, Froude number, stride and
+    its length against Alexander's 2.3 Fr^0.3, apex, ankle excursion, stride CV, trunk lean;
+    then the ground: the peak vertical force per foot (body weights, where in the stance) and
+    the stance's horizontal impulses."""
+    from cpgbiped.envs.gaits.criteria import alexander_relative_stride
+
+    def f(key, p=2, scale=1.0):
+        x = s.get(key)
+        return "nan" if x is None or not np.isfinite(x) else f"{scale * x:.{p}f}"
+
+    fr = s.get("froude")
+    alex = (f"{alexander_relative_stride(fr):.2f}" if fr is not None and np.isfinite(fr) and fr > 0
+            else "nan")
+    return (f"biomechanics: speed {f('speed_mps')} m/s, Fr {f('froude', 3)}, stride "
+            f"{f('stride_period_s')} s, stride/leg {f('relative_stride_length')} (Alexander "
+            f"{alex}), apex {f('apex_height_m', 1, 100)} cm, ankle excursion "
+            f"{f('ankle_excursion_deg', 0)} deg, stride CV {f('stride_cv', 1, 100)}%, trunk lean "
+            f"{f('trunk_lean_deg', 0)} deg\n"
+            f"ground: peak vertical force {f('peak_vertical_grf_bw', 1)} body weights at "
+            f"{f('peak_vertical_grf_at')} of the stance; horizontal impulse "
+            f"{f('stance_impulse_first_half_Ns', 1)} / {f('stance_impulse_second_half_Ns', 1)} N s "
+            f"(stance first / second half), touches {f('touch_impulse_per_step_Ns', 1)} N s per step")
+
+
 def metrics_table(summaries: dict[str, dict]) -> str:
     """Physical metrics and verdicts as text, from ``Validation.summary()`` per rollout."""
     from cpgbiped.cpg.io import format_table
