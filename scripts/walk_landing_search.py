@@ -1,0 +1,183 @@
+"""The walk corner's landing searched for a softer heel strike at the same speed: CMA-ES on
+tuning states only.
+
+The committed walk lands on its toes with the knee flexed 47 degrees, and its heel slaps down
+50 ms later at about 4 body weights (a human walk peaks at 1.1-1.3; README, "The vertical ground
+forces"). A straighter landing knee alone lowers the peak but slows the walk to Fr 0.06, and a
+slower walk slaps less whatever slows it (docs/JOURNAL.md, session 36). This searches ten gains
+of the walk's corner (``corners.alternating``: the landing knee and its stiffness in the air,
+the stance knee's crouch, stiffness and push, the landing's yield, the trailing leg's push-off,
+the early swing's toe lift, and the foot placement's offset and speed gain, which hold the
+speed) with pymoo's CMA-ES (seeded), in the box LO-HI. Score of a candidate (lower is better),
+per walk rollout of 2 s + 20 s from CPG seeds STATES, averaged:
+
+- a fall: 12;
+- otherwise PEAK_WEIGHT times the median over stances of each foot's largest vertical ground
+  force, in body weights (``validate``'s ``peak_vertical_grf_bw``),
+  + 5 per 0.01 of Froude number below FR_MIN (the speed held),
+  + 3 if the walk fails any of its criteria (envs/gaits/criteria.py),
+  + DUTY_COST per unit of the smaller duty factor below DUTY_MIN (a margin over the walk
+    pattern's 0.55),
+  + CROUCH_COST per degree of the stance knee's flexion (the median over stances after 4 s of
+    its mean at 0.3-0.7 of the stance) beyond KNEE_MID_DEG, the committed walk's (a softer
+    landing bought with a crouched walk is not the walk asked for).
+
+The other gaits are not scored: the walk's corner reaches them only through the features'
+blend in their first seconds, and whether that costs them is the adoption rule's question.
+
+    python scripts/walk_landing_search.py --start GAINS.json [--out out/walk_landing]
+
+Writes OUT/gains.json (the start file with the corner's gains replaced, as a link of a tuning
+chain: set_by_hand's provenance entry, naming this script) and OUT/history.jsonl (every
+candidate's score and medians). About 5 minutes on 2 cores.
+
+What it found (2026-12-06, session 37; docs/JOURNAL.md), from the committed gains: score
+8.70 -> 4.80; over the 12 search states the walk's median peak 4.05 -> 2.08 body weights at Fr
+0.113, double support 0.146, stance knee 30.7 degrees (27 before); over the held-out tuning
+states 1012-1047 peak 2.07, Fr 0.113, the walk passing in 35 of 36 (one fall), the run 36, the
+jump 35, the hop 32. It still lands on its toes (the foot 18.5 degrees toes-down at touchdown,
+the knee flexed 56 degrees against 47): the landing yields, it does not turn into a heel strike.
+Put to a rule fixed before it met any other state (journal, session 37): over unused CPG states
+2600-2699 the walk's peak 4.05 -> 2.07 at Fr 0.114 (L1 met) and the perturbations kept 697 ->
+712 of 840, but the hop passes in 81 against 86 (committed - 3 asked) and the walk in 96
+against 99, its falls 0 -> 3: not adopted. Earlier settings of the same search (seed 42, the
+peak weighted 1, the duty's margin 200 per unit, 30 and 50 generations) found peaks of 2.52 and
+2.65 with the knee at 31 and 27 degrees.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+NAMES = ("knee_land", "theta0", "c_v", "push", "push_off", "kp_air", "knee_crouch", "toe_up",
+         "kp_knee", "land_yield")
+LO = np.array([-1.3, 0.0, 0.2, 0.0, 0.0, 0.15, -0.8, 0.0, 0.3, 0.0])
+HI = np.array([-0.4, 0.35, 0.6, 0.3, 0.4, 1.0, -0.2, 0.8, 2.0, 1.0])
+CORNER = "alternating"
+STATES = tuple(range(1000, 1012))  # tuning CPG states
+SETTLE_S, MEASURED_S = 2.0, 20.0
+FR_MIN = 0.10
+DUTY_MIN, DUTY_COST = 0.565, 100.0
+PEAK_WEIGHT = 2.0
+KNEE_MID_DEG, CROUCH_COST = 27.0, 0.1
+FALL_COST = 12.0
+POP, GENS, SIGMA, SEED = 10, 40, 0.15, 43
+NOTE = ("the walk corner's landing found by python scripts/walk_landing_search.py --start "
+        "{start} --out {out} (pymoo CMA-ES, seed %d, pop %d, %d generations, sigma %g in the box "
+        "of the script; tuning CPG states %d-%d, the walk over %g s + %g s: the median peak "
+        "vertical force per foot, Fr below %g, the criteria, the duty below %g and the stance "
+        "knee's flexion beyond %g degrees scored): score {start_score:.3f} -> {score:.3f}, "
+        "{info}. " % (SEED, POP, GENS, SIGMA, STATES[0], STATES[-1], SETTLE_S, MEASURED_S,
+                      FR_MIN, DUTY_MIN, KNEE_MID_DEG))
+
+
+def knee_mid_deg(rec) -> float | None:
+    """The stance knee's flexion (degrees, > 0 flexed): the median over stances after 4 s of its
+    mean over 0.3-0.7 of the stance."""
+    from cpgbiped.envs.gaits.gait_metrics import stances
+
+    full, _ = stances(rec.contact, rec.dt)
+    mids = [np.degrees(-rec.joints[a + int(0.3 * (b - a)):a + int(0.7 * (b - a)) + 1,
+                                   3 * i + 1].mean())
+            for i, a, b in full if rec.t[a] >= 4.0 and b - a > 10]
+    return float(np.median(mids)) if mids else None
+
+
+def one(job) -> tuple:
+    """(cost, summary) of one walk rollout: job = (params, CPG seed)."""
+    params, seed = job
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.gaits.validate import measure_recording
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    net = build("ml", "walk", seed=seed)
+    rec = rollout(net, SETTLE_S + MEASURED_S, params, poses=False)
+    s = measure_recording(net, "walk", rec, SETTLE_S).summary()
+    s = {k: s[k] for k in ("fell", "passed", "froude", "peak_vertical_grf_bw",
+                           "peak_vertical_grf_at", "duty_factor", "double_support")}
+    if s["fell"]:
+        return FALL_COST, s
+    s["knee_mid_deg"] = knee = knee_mid_deg(rec)
+    cost = (PEAK_WEIGHT * s["peak_vertical_grf_bw"] + 5.0 * max(0.0, FR_MIN - s["froude"]) / 0.01
+            + (0.0 if s["passed"] else 3.0)
+            + DUTY_COST * max(0.0, DUTY_MIN - min(s["duty_factor"].values()))
+            + CROUCH_COST * max(0.0, (90.0 if knee is None else knee) - KNEE_MID_DEG))
+    return float(cost), s
+
+
+def params_of(base, x):
+    return base.with_corner(CORNER, **{n: float(v) for n, v in zip(NAMES, x)})
+
+
+def evaluate(ex, base, X) -> list:
+    jobs = [(params_of(base, x), sd) for x in X for sd in STATES]
+    res = list(ex.map(one, jobs, chunksize=4))
+    n = len(STATES)
+    return [(float(np.mean([c for c, _ in res[i * n:(i + 1) * n]])), res[i * n:(i + 1) * n])
+            for i in range(len(X))]
+
+
+def medians(rows) -> dict:
+    ss = [s for _, s in rows if not s["fell"]]
+
+    def med(k):
+        v = [s[k] for s in ss if s.get(k) is not None]
+        return round(float(np.median(v)), 4) if v else None
+    return {"stood": len(ss), "passed": sum(s["passed"] for _, s in rows), "froude": med("froude"),
+            "peak_bw": med("peak_vertical_grf_bw"), "peak_at": med("peak_vertical_grf_at"),
+            "double_support": med("double_support"), "knee_mid_deg": med("knee_mid_deg")}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--start", required=True, help="gains file to start from")
+    ap.add_argument("--out", default="out/walk_landing")
+    a = ap.parse_args()
+    from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.core.problem import Problem
+    from pymoo.core.termination import NoTermination
+    from pymoo.problems.static import StaticProblem
+
+    from cpgbiped.envs.control.controller import read_gains
+    from cpgbiped.envs.search.controller_tuning import set_by_hand
+
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    base, _ = read_gains(a.start)
+    x0 = np.array([getattr(base.corner(CORNER), n) for n in NAMES])
+    problem = Problem(n_var=len(NAMES), n_obj=1, xl=0.0, xu=1.0)
+    alg = CMAES(x0=np.clip((x0 - LO) / (HI - LO), 0.0, 1.0), sigma=SIGMA, popsize=POP,
+                restarts=0, seed=SEED)
+    alg.setup(problem, termination=NoTermination())
+    with ProcessPoolExecutor(2) as ex, open(out / "history.jsonl", "w") as log:
+        f0, r0 = evaluate(ex, base, [x0])[0]
+        best = (f0, x0, r0)
+        print(f"start: {f0:.3f} {medians(r0)}", flush=True)
+        for gen in range(GENS):
+            pop = alg.ask()
+            X = LO + np.clip(pop.get("X"), 0.0, 1.0) * (HI - LO)
+            res = evaluate(ex, base, X)
+            Evaluator().eval(StaticProblem(problem, F=np.array([[f] for f, _ in res])), pop)
+            alg.tell(infills=pop)
+            for x, (f, rows) in zip(X, res):
+                log.write(json.dumps({"gen": gen, "score": f, "x": dict(zip(NAMES, x.tolist())),
+                                      **medians(rows)}) + "\n")
+                if f < best[0]:
+                    best = (f, x, rows)
+            log.flush()
+            print(f"generation {gen}: best so far {best[0]:.3f} {medians(best[2])}", flush=True)
+    f, x, rows = best
+    info = ", ".join(f"{k} {v}" for k, v in medians(rows).items())
+    note = NOTE.format(start=a.start, out=a.out, start_score=f0, score=f, info=info)
+    set_by_hand(a.start, {f"{CORNER}.{n}": float(v) for n, v in zip(NAMES, x)},
+                out / "gains.json", note)
+    print(f"wrote {out / 'gains.json'}: {dict(zip(NAMES, np.round(x, 4).tolist()))}")
+
+
+if __name__ == "__main__":
+    main()
