@@ -59,6 +59,11 @@ from pathlib import Path
 
 import numpy as np
 
+from cpgbiped.envs.gaits.criteria import SETTLE_S
+
+# the other presets' guard: walk_startup_search's (this folder is on sys.path when a script runs)
+from walk_startup_search import GUARD_S, GUARD_SEEDS as GUARD_STATES, guard_terms
+
 NAMES = ("knee_land", "theta0", "c_v", "push", "push_off", "kp_air", "knee_crouch", "toe_up",
          "kp_knee", "land_yield")
 LO = np.array([-1.3, 0.0, 0.2, 0.0, 0.0, 0.15, -0.8, 0.0, 0.3, 0.0])
@@ -66,10 +71,10 @@ HI = np.array([-0.4, 0.35, 0.6, 0.3, 0.4, 1.0, -0.2, 0.8, 2.0, 1.0])
 CORNER = "alternating"
 STATES = tuple(range(1000, 1012))  # tuning CPG states
 # --guard: more walk states, and the other presets' criteria and falls in the score (their
-# first seconds blend the walk's corner), as scripts/walk_startup_search.py guards them
+# first seconds blend the walk's corner), with scripts/walk_startup_search.py's guard
+# (GUARD_STATES 1000-1007, 2 s + GUARD_S = 12 s each)
 GUARD_WALK_STATES = tuple(range(1000, 1020))
-GUARD_STATES, GUARD_S = tuple(range(1000, 1008)), 12.0
-SETTLE_S, MEASURED_S = 2.0, 20.0
+MEASURED_S = 20.0
 FR_MIN = 0.10
 DUTY_MIN, DUTY_COST = 0.565, 100.0
 PEAK_WEIGHT = 2.0
@@ -119,20 +124,6 @@ def one(job) -> tuple:
     return float(cost), s
 
 
-def guard_one(job) -> tuple:
-    """(fell, passed its criteria) of a guarded preset over 2 s + GUARD_S: job = (params, gait,
-    CPG seed)."""
-    params, gait, seed = job
-    from cpgbiped.cpg.network import build
-    from cpgbiped.envs.gaits.validate import measure_recording
-    from cpgbiped.envs.simulation.rollout import rollout
-
-    net = build("ml", gait, seed=seed)
-    rec = rollout(net, SETTLE_S + GUARD_S, params, poses=False)
-    m = measure_recording(net, gait, rec, SETTLE_S).summary()
-    return bool(m["fell"]), bool(m["passed"])
-
-
 def params_of(base, x):
     return base.with_corner(CORNER, **{n: float(v) for n, v in zip(NAMES, x)})
 
@@ -150,7 +141,7 @@ def evaluate(ex, base, X, guard: bool = False, duty=(DUTY_MIN, DUTY_COST)) -> li
     if guard:
         gj = [(params_of(base, x), g, sd) for x in X for g in ("run", "jump", "hop")
               for sd in GUARD_STATES]
-        gr = list(ex.map(guard_one, gj, chunksize=4))
+        gr = list(ex.map(guard_terms, gj, chunksize=4))
         m = 3 * len(GUARD_STATES)
         out = [(f + float(np.mean([10.0 * fell + 3.0 * (not ok)
                                    for fell, ok in gr[i * m:(i + 1) * m]])), rows)
