@@ -711,3 +711,53 @@ def test_startup_tau_is_rechosen_on_the_live_gains_own_startup_corners(tmp_path)
     assert CONTROL.startup_tau_s == chosen
     set_startup(GAINS_FILE, own, chosen, tmp_path / "g.json", "a test")
     assert params_sha256(read_gains(tmp_path / "g.json")[0]) == params_sha256(CONTROL)
+
+
+def _rule_rates():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "rule_rates.py"
+    spec = importlib.util.spec_from_file_location("rule_rates", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_rule_rates_counts_each_clause_over_its_own_states():
+    """scripts/rule_rates.py (the measurements of an adoption rule): passes and falls over
+    every state, perturbation rollouts only over the first n_perturbed states (their
+    unperturbed row included), feedback rows and the Table 3 row apart. Synthetic rows, counted
+    by hand."""
+    rr = _rule_rates()
+
+    def row(seed, kind="unperturbed", feedback=0.0, passed=True, fell=False, kept=True):
+        return {"gait": "walk", "seed": seed, "kind": kind, "feedback": feedback,
+                "passed": passed, "fell": fell, "kept": kept}
+
+    rows = [row(5000), row(5001, passed=False, kept=False, fell=True), row(5002),
+            row(5003, passed=False, kept=True),  # not among the first 2: not a perturbed count
+            row(5000, "push +5", kept=False), row(5001, "push +5"),
+            row(5000, feedback=0.01, passed=False, fell=True), row(5001, feedback=0.01),
+            row(None, passed=False)]
+    c = rr.counts(rows, first=5000, n_perturbed=2)
+    assert (c["passes walk"], c["falls walk"]) == (2, 1)
+    assert c["kept walk unperturbed"] == 1 and c["kept walk push +5"] == 1
+    assert c["kept walk"] == 2 and c["kept all"] == 2
+    assert (c["feedback passes walk"], c["feedback falls walk"]) == (1, 1)
+    assert c["Table 3 passes walk"] == 0 and c["passes run"] == 0
+    # two binomial counts of 50 in 100 each: sd of the difference sqrt(2 x 100 x 1/4)
+    assert rr.noise(50, 50, 100) == pytest.approx(50 ** 0.5)
+    assert rr.noise(0, 100, 100) == 0.0
+
+
+def test_rule_rates_refuses_the_tuning_and_test_states(monkeypatch, capsys):
+    """A rule counted over tuning states (1000-1099) or the tests' (10-19) would not be a rule:
+    refused with a usage error before any rollout."""
+    rr = _rule_rates()
+    for first in ("1090", "5", "15"):
+        monkeypatch.setattr("sys.argv", ["rule_rates.py", "x.json", "--first", first])
+        with pytest.raises(SystemExit) as e:
+            rr.main()
+        assert e.value.code == 2
+        assert "overlap" in capsys.readouterr().err

@@ -1,0 +1,157 @@
+"""A candidate gains file against a baseline, counted over CPG states no tuning used: the
+measurements of an adoption rule on rates (journal, sessions 35, 37, 38).
+
+    python scripts/rule_rates.py CANDIDATE.json --first 2900 [--baseline GAINS.json]
+                                 [--n 100] [--n-perturbed 30] [--n-feedback 50] [--json OUT]
+
+The body is chaotic: one test condition is a coin, so a change of the gains is judged by rates
+over many random initial CPG states (seeds [--first, --first + n)), each preset (Table 2
+weights) validated for 20 s after 2 s of settling, as ``cpgbiped validate`` does. Counted, for
+the baseline (default: the committed gains) and the candidate, in the same run:
+
+- passes of every criterion and falls, per preset, over n states, open loop;
+- the perturbation rollouts kept (named their own gait by the contacts, no fall) per preset
+  and kind over the first --n-perturbed states: unperturbed, friction x0.5 and x2.0, and at
+  6 s +-5 N s held 0.2 s (SCONE's) or as a one-tick blow (7 kinds x 4 presets);
+- passes with the body's feedback into the CPG (the recommended gain) over the first
+  --n-feedback states;
+- each preset from its Table 3 state, open loop: passes.
+
+Beside each difference, its sampling noise: the standard deviation of a difference of two
+binomial counts over the same number of states, sqrt(n p1 (1 - p1) + n p2 (1 - p2)) with the
+observed rates (the two gains' rollouts are not independent draws, so this is a scale for the
+tolerances a rule should fix beforehand, not a test). A rule fixes its clauses and its seed
+bank before the candidate meets these states; this script only counts.
+
+Seed banks used so far (do not reuse them for a new rule): 10-19 the tests' random states;
+1000-1099 tuning; 2000-2099, 2100-2147, 2200-2349, 2350-2379, 2400-2419, 2450-2479 and
+2500-2899 earlier rules; 3000-3099 and 4000-4099 censuses, transitions and secondary checks.
+Unused: 2900-2999, 5000 and up.
+"""
+import argparse
+import json
+import math
+from concurrent.futures import ProcessPoolExecutor
+
+GAITS = ("walk", "run", "jump", "hop")
+PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
+                 "friction x2.0": {"friction_scale": 2.0},
+                 "push +5": {"push": (6.0, 5.0, 0.2)}, "push -5": {"push": (6.0, -5.0, 0.2)},
+                 "blow +5": {"push": (6.0, 5.0, 0.004)}, "blow -5": {"push": (6.0, -5.0, 0.004)}}
+SECONDS = 20.0
+
+
+def one(job):
+    """One preset from one state (None: its Table 3 state) under one condition."""
+    gains, gait, seed, kind, feedback = job
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.control.controller import read_gains
+    from cpgbiped.envs.gaits.validate import validate
+
+    kw = PERTURBATIONS[kind]
+    s = validate(build("ml", gait, seed=seed), gait, SECONDS, params=read_gains(gains)[0],
+                 friction_scale=kw.get("friction_scale", 1.0), push=kw.get("push"),
+                 feedback=feedback).summary()
+    return {"gait": gait, "seed": seed, "kind": kind, "feedback": feedback,
+            "passed": bool(s["passed"]), "fell": bool(s["fell"]),
+            "kept": bool(s["physical_gait"] == gait and not s["fell"])}
+
+
+def jobs(gains, first, n, n_perturbed, n_feedback, k_feedback):
+    out = [(gains, g, s, "unperturbed", 0.0) for g in GAITS for s in range(first, first + n)]
+    out += [(gains, g, s, k, 0.0) for g in GAITS for s in range(first, first + n_perturbed)
+            for k in PERTURBATIONS if k != "unperturbed"]
+    out += [(gains, g, s, "unperturbed", k_feedback) for g in GAITS
+            for s in range(first, first + n_feedback)]
+    out += [(gains, g, None, "unperturbed", 0.0) for g in GAITS]
+    return out
+
+
+def counts(rows, first, n_perturbed):
+    """The rule's counts from one gains file's rows."""
+    ol = [r for r in rows if r["feedback"] == 0 and r["seed"] is not None]
+    plain = [r for r in ol if r["kind"] == "unperturbed"]
+    pert = [r for r in ol if r["kind"] != "unperturbed" or r["seed"] < first + n_perturbed]
+    fb = [r for r in rows if r["feedback"] > 0]
+    t3 = [r for r in rows if r["seed"] is None]
+    c = {}
+    for g in GAITS:
+        c[f"passes {g}"] = sum(r["passed"] for r in plain if r["gait"] == g)
+        c[f"falls {g}"] = sum(r["fell"] for r in plain if r["gait"] == g)
+    for g in GAITS:
+        for k in PERTURBATIONS:
+            c[f"kept {g} {k}"] = sum(r["kept"] for r in pert if r["gait"] == g and r["kind"] == k)
+        c[f"kept {g}"] = sum(r["kept"] for r in pert if r["gait"] == g)
+    c["kept all"] = sum(r["kept"] for r in pert)
+    for g in GAITS:
+        c[f"feedback passes {g}"] = sum(r["passed"] for r in fb if r["gait"] == g)
+        c[f"feedback falls {g}"] = sum(r["fell"] for r in fb if r["gait"] == g)
+    for g in GAITS:
+        c[f"Table 3 passes {g}"] = sum(r["passed"] for r in t3 if r["gait"] == g)
+    return c
+
+
+def sizes(n, n_perturbed, n_feedback):
+    """How many rollouts each count is over."""
+    s = {}
+    for g in GAITS:
+        s[f"passes {g}"] = s[f"falls {g}"] = n
+        for k in PERTURBATIONS:
+            s[f"kept {g} {k}"] = n_perturbed
+        s[f"kept {g}"] = n_perturbed * len(PERTURBATIONS)
+        s[f"feedback passes {g}"] = s[f"feedback falls {g}"] = n_feedback
+        s[f"Table 3 passes {g}"] = 1
+    s["kept all"] = n_perturbed * len(PERTURBATIONS) * len(GAITS)
+    return s
+
+
+def noise(a, b, n):
+    """Standard deviation of b - a for two binomial counts over n draws each."""
+    if n <= 1:
+        return 0.0
+    p, q = a / n, b / n
+    return math.sqrt(n * p * (1 - p) + n * q * (1 - q))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("candidate", help="the candidate gains file")
+    ap.add_argument("--baseline", default="envs/control/gains.json")
+    ap.add_argument("--first", type=int, required=True, help="the rule's first CPG seed")
+    ap.add_argument("--n", type=int, default=100)
+    ap.add_argument("--n-perturbed", type=int, default=30)
+    ap.add_argument("--n-feedback", type=int, default=50)
+    ap.add_argument("--json", default=None, help="write every rollout's row here")
+    a = ap.parse_args()
+    if not (a.n >= a.n_perturbed >= 0 and a.n >= a.n_feedback >= 0 and a.n > 0):
+        ap.error("--n must be positive and at least --n-perturbed and --n-feedback")
+    if 10 <= a.first + a.n - 1 and a.first <= 19 or a.first < 1100 and a.first + a.n > 1000:
+        ap.error("the states overlap the tests' (10-19) or the tuning's (1000-1099)")
+    from cpgbiped.cpg.feedback import RECOMMENDED
+
+    k_fb = RECOMMENDED["ml"]
+    rows = {}
+    with ProcessPoolExecutor(2) as ex:
+        for name, gains in (("baseline", a.baseline), ("candidate", a.candidate)):
+            rows[name] = list(ex.map(one, jobs(gains, a.first, a.n, a.n_perturbed, a.n_feedback,
+                                               k_fb), chunksize=8))
+    cb = counts(rows["baseline"], a.first, a.n_perturbed)
+    cc = counts(rows["candidate"], a.first, a.n_perturbed)
+    sz = sizes(a.n, a.n_perturbed, a.n_feedback)
+    print(f"CPG seeds {a.first}-{a.first + a.n - 1} (perturbed: the first {a.n_perturbed}, "
+          f"feedback K = {k_fb}: the first {a.n_feedback}); baseline {a.baseline}, "
+          f"candidate {a.candidate}")
+    print(f"{'count':34s} {'of':>5s} {'baseline':>9s} {'candidate':>10s} {'diff':>6s} {'noise sd':>9s}")
+    for key in cb:
+        print(f"{key:34s} {sz[key]:5d} {cb[key]:9d} {cc[key]:10d} {cc[key] - cb[key]:+6d} "
+              f"{noise(cb[key], cc[key], sz[key]):9.1f}")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump({"first": a.first, "n": a.n, "n_perturbed": a.n_perturbed,
+                       "n_feedback": a.n_feedback, "feedback_gain": k_fb,
+                       "baseline": a.baseline, "candidate": a.candidate,
+                       "counts": {"baseline": cb, "candidate": cc}, "rows": rows}, f)
+
+
+if __name__ == "__main__":
+    main()
