@@ -132,6 +132,11 @@ python3 scripts/hop_squat_search.py --census-box squat_kav --census-seed 10 --ba
 prev="$OUT/hs/gains.json"
 python3 scripts/walk_startup_search.py --start "$prev" --guard falls --adopted --out "$OUT/ws"
 prev="$OUT/ws/gains.json"
+# A lone foot in a synchronous rhythm lands (README, "Status"; journal, session 38): a foot off
+# the ground while the other stands in the jump's or the hop's rhythm extends to land instead of
+# tucking by its swing drive; set by hand after a rule on rates over unused CPG states.
+python3 scripts/sync_land.py "$prev" "$OUT"
+prev="$OUT/sl/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

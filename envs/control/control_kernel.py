@@ -26,7 +26,8 @@ from cpgbiped.cpg.feedback import outputs as fb_outputs
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in
 # CORNER order: (sigma, kappa) = (0, 0), (0, 1), (1, 0), (1, 1).
-SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort", "restart_v")
+SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort", "restart_v",
+          "sync_land")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
@@ -35,7 +36,7 @@ BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "k
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
                  "lean_knee": 0.0, "toe_up": 0.0}
-ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0}
+ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0, "sync_land": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
 ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up")
@@ -153,6 +154,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     ankle_gain, e_on, w_flex, w_cross, contact_hold = P[0], P[1], P[2], P[3], P[4]
     lift_abort = P[5] > 0.5
     restart_v = P[6]  # m/s; 0: off
+    sync_land = P[7] > 0.5
     # Per leg i (0 left, 1 right): flexor f = a[i], extensor e = a[2 + i].
     e = np.empty(2)
     f = np.empty(2)
@@ -388,7 +390,13 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             # the swing drive tucks the leg while its foot is behind the hip (clearance); once
             # the foot is x_clear ahead of it the knee extends to land
             behind = _clip01((hip_x + x_clear - foot_x[i]) / 0.05)
-            target = knee_land + (knee_swing - knee_land) * g[i] * behind
+            gi = g[i]
+            # sync_land: in a rhythm whose legs push together, a foot that is off the ground
+            # while the other is on it (it was not lifted: no leg lifts on its own there)
+            # extends to land instead of tucking by the swing drive.
+            if sync_land and sigma >= SIGMA_LIFT and ground[1 - i] and S[S_SWUNG + i] < 0.5:
+                gi = 0.0
+            target = knee_land + (knee_swing - knee_land) * gi * behind
             k = kp_air * (target - knee[i]) - kd_knee * knee_rate[i]
             # Swing clearance: the dorsiflexor lifts the toes of a foot off the ground while
             # it is behind the hip, early in the swing (toe_up, activation; 0 adds nothing).
