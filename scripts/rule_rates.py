@@ -25,12 +25,15 @@ bank before the candidate meets these states; this script only counts.
 
 Seed banks used so far (do not reuse them for a new rule): 10-19 the tests' random states;
 1000-1099 tuning; 2000-2099, 2100-2147, 2200-2349, 2350-2379, 2400-2419, 2450-2479 and
-2500-2899 earlier rules; 3000-3099 and 4000-4099 censuses, transitions and secondary checks.
-Unused: 2900-2999, 5000 and up.
+2500-2999 earlier rules (2800-2899 and 2900-2999 in session 38); 3000-3099 and 4000-4099
+censuses, transitions and secondary checks. Unused: 5000 and up. The tests' and the tuning's
+states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
+is what it is for then).
 """
 import argparse
 import json
 import math
+import sys
 from concurrent.futures import ProcessPoolExecutor
 
 GAITS = ("walk", "run", "jump", "hop")
@@ -39,6 +42,9 @@ PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
                  "push +5": {"push": (6.0, 5.0, 0.2)}, "push -5": {"push": (6.0, -5.0, 0.2)},
                  "blow +5": {"push": (6.0, 5.0, 0.004)}, "blow -5": {"push": (6.0, -5.0, 0.004)}}
 SECONDS = 20.0
+# (first, last) CPG seeds of the banks earlier rules, censuses and checks used (docstring)
+USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
+              (2500, 2999), (3000, 3099), (4000, 4099))
 
 
 def one(job):
@@ -127,7 +133,20 @@ def main() -> None:
         ap.error("--n must be positive and at least --n-perturbed and --n-feedback")
     if 10 <= a.first + a.n - 1 and a.first <= 19 or a.first < 1100 and a.first + a.n > 1000:
         ap.error("the states overlap the tests' (10-19) or the tuning's (1000-1099)")
+    used = [(lo, hi) for lo, hi in USED_BANKS if a.first <= hi and a.first + a.n - 1 >= lo]
+    if used:
+        print("note: CPG seeds " + ", ".join(f"{lo}-{hi}" for lo, hi in used) + " were used by "
+              "an earlier rule or census: fine for re-counting it, not for a new rule",
+              file=sys.stderr)
+    from cpgbiped.cpg.errors import InputError
     from cpgbiped.cpg.feedback import RECOMMENDED
+    from cpgbiped.envs.control.controller import read_gains
+
+    for gains in (a.baseline, a.candidate):  # both readable before any rollout starts
+        try:
+            read_gains(gains)
+        except (InputError, OSError) as e:
+            ap.error(f"{gains}: {e}")
 
     k_fb = RECOMMENDED["ml"]
     rows = {}

@@ -385,15 +385,54 @@ def test_lift_abort_ends_a_lift_that_the_other_foot_leaves_alone():
     assert on.fell_at is None
 
 
+def _lone_left_knee(params, sigma_high=True, swung=False, right_down=True):
+    """The left knee's control at t = 1 s, the first call of a fresh controller on the lifted
+    body: the left foot off the ground, the right counted on it (its last contact at this tick,
+    within the contact hold) unless right_down is False, the left leg's swing drive on (its
+    flexor bursting, its extensor silent). sigma_high: the features' neutral prior, sigma = 0.5
+    >= SIGMA_LIFT (else sigma = 0); swung: the left leg latched as lifted by its swing drive."""
+    m, d = lifted_body()
+    a = np.zeros((1000, 4))
+    a[:, 0] = 1.0
+    ctl = CPGController(m, d, synthetic(a), params=params)
+    if right_down:
+        ctl.S[K.S_LAST_GROUND + 1] = 1.0
+    if not sigma_high:
+        ctl.S[K.S_C_LR] = 0.0
+    if swung:
+        ctl.S[K.S_SWUNG] = 1.0
+        ctl.S[K.S_AIRBORNE] = 1.0
+    u = ctl(1.0).copy()
+    return u[6], ctl.modes
+
+
+def test_sync_land_opens_only_for_a_lone_unlatched_foot_in_a_synchronous_rhythm():
+    """sync_land's gates, each closed in turn (the controller's docstring, step 5): the left
+    knee's control differs with and without the switch only when the right foot is down, the
+    left is off the ground and not latched as swinging, and sigma >= SIGMA_LIFT; and with the
+    switch the knee is driven towards its landing angle, not tucked (a larger, extending,
+    torque: knee angles are negative when flexed)."""
+    from dataclasses import replace
+
+    off, on = replace(CONTROL, sync_land=0.0), replace(CONTROL, sync_land=1.0)
+    k_off, modes = _lone_left_knee(off)
+    k_on, _ = _lone_left_knee(on)
+    assert list(modes) == [K.MODE_AIR, K.MODE_SUPPORT]
+    assert k_on > k_off + 1e-3
+    for gate in (dict(sigma_high=False), dict(swung=True), dict(right_down=False)):
+        assert _lone_left_knee(on, **gate)[0] == _lone_left_knee(off, **gate)[0], gate
+
+
 def test_sync_land_acts_only_on_a_lone_foot_and_keeps_stumbling_hops_up():
     """sync_land (scripts/sync_land.py): in a synchronous rhythm a foot off the ground while the
-    other stands, not lifted by the swing latch, extends to land instead of tucking. The switch
-    changes nothing until such a foot exists: the hop's controls with and without it are equal
-    up to the first tick with one foot in the air and the other in support. Of the five tuning
-    CPG states from which the hop with feedback fell at 5.0-5.5 s without it (CPG seeds
-    1000-1099; the set is chosen by that fall, not by the outcome with the switch), at least
-    three keep hopping to 10 s with it (measured: 1049, 1052 and 1060; 1046 falls at 4.9 s and
-    1094 at 8.5 s)."""
+    other stands, not lifted by the swing latch, extends to land instead of tucking. In the
+    hop's rollouts the first tick at which the controls with and without it differ is one with
+    one foot in the air and the other in support (the gates themselves: the test above). Of the
+    five tuning CPG states from which the hop with feedback fell at 5.0-5.5 s without it (CPG
+    seeds 1000-1099; the set is chosen by that fall, not by the outcome with the switch), at
+    least three keep hopping to 10 s with it (measured: exactly three, 1049, 1052 and 1060, so
+    the margin is zero; 1046, the state the stumble was traced from, falls at 4.9 s with it,
+    earlier than without, and 1094 at 8.5 s)."""
     from dataclasses import replace
 
     from cpgbiped.envs.simulation.rollout import rollout

@@ -75,8 +75,9 @@ KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
     # perturbations (non-strict: a fall or a name at a threshold's edge is chaotic). Since the
     # hop's corner and the walk's start-up corner the run keeps friction x0.5 (it fell in its
     # start-up there). Since sync_land (session 38) the hop keeps friction x2.0 (it was named a
-    # jump; over 30 unused random states kept in 12 -> 15) and falls after the -5 N s push
-    # held 0.2 s (it kept it; over the same states 14 -> 18)
+    # jump; kept over the rule's CPG seeds 2900-2929 in 12 -> 15, over the README's 3000-3029
+    # in 12 -> 13) and falls after the -5 N s push held 0.2 s (it kept it; kept over 2900-2929
+    # in 14 -> 18, over 3000-3029 in 15 -> 11)
     "jump-push+5": ("falls at 7.3 s: pushed forwards in its flexor burst, it takes off from its "
                     "toes and runs away forwards", False),
     "hop-push-5": ("falls at 10.3 s", False),

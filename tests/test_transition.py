@@ -159,11 +159,11 @@ K_FB = RECOMMENDED["ml"]
 IN_FAMILY_CASES = [(a, b, r, k) for a, b in sorted(IN_FAMILY) for r in (0.0, 2.0)
                    for k in (0.0, K_FB)]
 IN_FAMILY_SHORTFALL = {
-    # since the hop's corner and the walk's start-up corner (2026-12-06, session 35,
-    # scripts/hop_squat_search.py, scripts/walk_startup_search.py; README "Transitions"; 5 of 16
-    # pass: walk -> run as an open-loop step, run -> walk as a step with feedback, hop -> jump
-    # as a step and a ramp with feedback, jump -> hop as a ramp with feedback), K_FB Taga's
-    # thigh angle. Before it (the run's swing clearance, session 34) 6 of 16: walk -> run as a
+    # since sync_land (2026-12-06, session 38, scripts/sync_land.py; README "Transitions") 6 of
+    # 16 pass: walk -> run as an open-loop step, run -> walk as a step with feedback, hop ->
+    # jump as a step and a ramp with feedback, jump -> hop as a step open loop and with
+    # feedback; K_FB Taga's thigh angle. From the hop's corner and the walk's start-up corner
+    # (session 35) to it 5 of 16: jump -> hop as a ramp with feedback instead of its steps. Before it (the run's swing clearance, session 34) 6 of 16: walk -> run as a
     # step either way, run -> walk and hop -> jump as a step and a ramp with feedback.
     ("walk", "run", 0.0, K_FB): "falls at 10.4 s, 2.4 s after the change (a run 1 CPG cycle "
                                 "after it before the hop's corner)",
@@ -476,9 +476,10 @@ def test_a_secondary_gait_chosen_by_the_body_is_confirmed_from_the_table3_state(
     """Issue 22: a secondary gait confirmed physically: both classifiers name the target and
     the body does not fall (the hesitation walk and the gallop from the jump: the two targets
     the body confirmed most often in the selection, 5 and 4 of 6 states, since the walk's
-    stance knee; the gallop from the walk and the hesitation walk from the jump before; the
-    gallop from the walk again since the hop's corner, session 35, which the body confirms from
-    the Table 3 state while the hesitation walk falls there)."""
+    stance knee; the gallop from the walk and the hesitation walk from the jump before). From
+    the hop's corner (session 35) to sync_land (session 38) the body confirmed both gallops
+    from the Table 3 state and the hesitation walk fell there; since sync_land the gallop from
+    the jump alone (PHYSICS_SHORTFALL)."""
     from cpgbiped.envs.experiments.secondary_check import _one, load_secondary
 
     (t,) = [t for t in load_secondary(PHYSICS_SECONDARY)

@@ -34,7 +34,7 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
          + sigma (1-kappa) p_synchronous + sigma kappa p_synchronous_coactive.
    A rhythm between the corners (a transition, a secondary gait, other weights) gets gains
    between theirs. The ankle gain, the swing wiring (e_on, w_flex, w_cross), contact_hold and
-   lift_abort (and sync_land, step 5) are shared by all. Nothing depends on a name.
+   lift_abort, restart_v and sync_land (step 5) are shared by all. Nothing depends on a name.
 2. Contacts and modes. A foot is on the ground while its contact force exceeds 1 N or did
    within the last ``contact_hold`` s. A leg *swings* from the moment its swing drive lifts
    it - g_i > 0.5 while it stands, the other leg stands with its stance command and no swing
@@ -99,9 +99,11 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        (the swing drive tucks the leg while its foot is behind x_clear ahead of the hip - the
        clearance; past that, or without the drive, the leg extends to land). With
        ``sync_land`` (shared; 1 in the committed gains since session 38, 0 reproduces the
-       controller before it), in a rhythm whose legs push together (sigma >= SIGMA_LIFT) a
-       foot off the ground while the other foot is on it, and not lifted by the swing latch
-       (no leg lifts on its own there), takes g_i = 0: it extends to land instead of tucking.
+       controller before it), in a rhythm whose legs push together (sigma >= SIGMA_LIFT; also
+       in every gait's first few tenths of a second, while sigma is near its neutral prior of
+       0.5) a foot off the ground while the other foot is on it, and not lifted by the swing
+       latch (no leg lifts on its own there), takes g_i = 0: it extends to land instead of
+       tucking.
        Such a foot is a stumble, not a swing: the hop's swing drive in its silence (the hop
        corner's swing_rest, 0.955) had tucked it, and the body, left on one leg, fell.
 
