@@ -26,7 +26,12 @@ the sweep ran, measured on CPG seeds 2800-2899 with
 
 kept the hop on friction x2.0 in 27 of 30 (14 with the committed gains) and every open-loop
 clause, but the hop with feedback passed in 36 of 50 against 45 (falls 2 -> 6; the noise of
-that difference about 3.8). The journal (session 38) has the rest.
+that difference about 3.8). A second rule, after sync_land was adopted, with the sweep re-run on
+those gains (choice 6.25; `python scripts/hop_ankle_reflex.py envs/control/gains.json OUT
+--sweep` exits with the mismatch against K_AX, which records the first choice) and CPG seeds
+5000-5099, failed the same way: the hop on x2.0 kept 12 -> 29 of 30, every open-loop clause
+met, the hop with feedback falls in 4 of 50 against 0 (out/s38/rule_hop_reflex2.md, quoted in
+the journal). The journal (session 38) has the rest.
 """
 import argparse
 import json

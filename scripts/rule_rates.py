@@ -25,8 +25,8 @@ bank before the candidate meets these states; this script only counts.
 
 Seed banks used so far (do not reuse them for a new rule): 10-19 the tests' random states;
 1000-1099 tuning; 2000-2099, 2100-2147, 2200-2349, 2350-2379, 2400-2419, 2450-2479 and
-2500-2999 earlier rules (2800-2899 and 2900-2999 in session 38); 3000-3099 and 4000-4099
-censuses, transitions and secondary checks. Unused: 5000 and up. The tests' and the tuning's
+2500-2999 and 5000-5099 earlier rules (2800-2899, 2900-2999 and 5000-5099 in session 38);
+3000-3099 and 4000-4099 censuses, transitions and secondary checks. Unused: 5100 and up. The tests' and the tuning's
 states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
 is what it is for then).
 """
@@ -44,7 +44,7 @@ PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
 SECONDS = 20.0
 # (first, last) CPG seeds of the banks earlier rules, censuses and checks used (docstring)
 USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
-              (2500, 2999), (3000, 3099), (4000, 4099))
+              (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099))
 
 
 def one(job):
