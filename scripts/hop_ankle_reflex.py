@@ -41,6 +41,9 @@ from pathlib import Path
 
 from cpgbiped.envs.search.controller_tuning import set_by_hand
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from census import one as census_one  # noqa: E402  (scripts/census.py: one preset, one state)
+
 K_AX = 6.75
 K_AX_GRID = (6.0, 6.25, 6.5, 6.75, 7.0)
 SEEDS = range(1000, 1040)
@@ -64,16 +67,12 @@ RULE = ("rule (out/s38/rule_hop_reflex.md, fixed before the sweep ran, CPG seeds
 
 
 def _one(job):
-    from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import read_gains
-    from cpgbiped.envs.gaits.validate import measure_recording
-    from cpgbiped.envs.simulation.rollout import rollout
-
+    """(passes every criterion, kept: named a hop without a fall) for one tuning state under
+    one condition (census.py's rollout, 20 s after settling)."""
     gains, seed, cond = job
-    n = build("ml", "hop")
-    n = n.with_state(n.random_state(seed))
-    rec = rollout(n, 22.0, read_gains(gains)[0], poses=False, **CONDITIONS[cond])
-    s = measure_recording(n, "hop", rec, 2.0).summary()
+    kw = CONDITIONS[cond]
+    _, _, s, _ = census_one(("hop", seed, gains, kw.get("friction_scale", 1.0), kw.get("push"),
+                             0.0))
     return bool(s["passed"]), bool(s["physical_gait"] == "hop" and not s["fell"])
 
 

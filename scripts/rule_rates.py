@@ -35,29 +35,28 @@ import json
 import math
 import sys
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from census import one as census_one  # noqa: E402  (scripts/census.py: one preset, one state)
 
 GAITS = ("walk", "run", "jump", "hop")
 PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
                  "friction x2.0": {"friction_scale": 2.0},
                  "push +5": {"push": (6.0, 5.0, 0.2)}, "push -5": {"push": (6.0, -5.0, 0.2)},
                  "blow +5": {"push": (6.0, 5.0, 0.004)}, "blow -5": {"push": (6.0, -5.0, 0.004)}}
-SECONDS = 20.0
 # (first, last) CPG seeds of the banks earlier rules, censuses and checks used (docstring)
 USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
               (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099))
 
 
 def one(job):
-    """One preset from one state (None: its Table 3 state) under one condition."""
+    """One preset from one state (None: its Table 3 state) under one condition (census.py's
+    rollout, 20 s after settling)."""
     gains, gait, seed, kind, feedback = job
-    from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import read_gains
-    from cpgbiped.envs.gaits.validate import validate
-
     kw = PERTURBATIONS[kind]
-    s = validate(build("ml", gait, seed=seed), gait, SECONDS, params=read_gains(gains)[0],
-                 friction_scale=kw.get("friction_scale", 1.0), push=kw.get("push"),
-                 feedback=feedback).summary()
+    _, _, s, _ = census_one((gait, seed, gains, kw.get("friction_scale", 1.0), kw.get("push"),
+                             feedback))
     return {"gait": gait, "seed": seed, "kind": kind, "feedback": feedback,
             "passed": bool(s["passed"]), "fell": bool(s["fell"]),
             "kept": bool(s["physical_gait"] == gait and not s["fell"])}
@@ -122,7 +121,8 @@ def noise(a, b, n):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("candidate", help="the candidate gains file")
-    ap.add_argument("--baseline", default="envs/control/gains.json")
+    ap.add_argument("--baseline", default=None,
+                    help="the baseline gains file (default: the committed gains)")
     ap.add_argument("--first", type=int, required=True, help="the rule's first CPG seed")
     ap.add_argument("--n", type=int, default=100)
     ap.add_argument("--n-perturbed", type=int, default=30)
@@ -142,6 +142,9 @@ def main() -> None:
     from cpgbiped.cpg.feedback import RECOMMENDED
     from cpgbiped.envs.control.controller import read_gains
 
+    from cpgbiped.envs.control.controller import GAINS_FILE
+
+    a.baseline = str(a.baseline or GAINS_FILE)
     for gains in (a.baseline, a.candidate):  # both readable before any rollout starts
         try:
             read_gains(gains)

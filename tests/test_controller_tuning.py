@@ -694,16 +694,12 @@ def test_startup_tau_is_rechosen_on_the_live_gains_own_startup_corners(tmp_path)
     takes the live gains' own start-up corners, so that re-setting them with the chosen tau_s
     changes nothing but tau_s; the committed gains hand over with the tau_s that selection
     chose (envs/control/startup_selection_end.json)."""
-    import importlib.util
     from pathlib import Path
 
     from cpgbiped.envs.search.controller_tuning import params_sha256, set_startup
 
     repo = Path(__file__).resolve().parents[1]
-    spec = importlib.util.spec_from_file_location("select_startup_tau",
-                                                  repo / "scripts" / "select_startup_tau.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _script("select_startup_tau")
     own = mod.own_startup_corners(str(GAINS_FILE), tmp_path / "own.json")
     src, _ = read_gains(own)
     assert tuple(src.corner(c) for c in CORNER_OF.values()) == CONTROL.startup
@@ -713,12 +709,13 @@ def test_startup_tau_is_rechosen_on_the_live_gains_own_startup_corners(tmp_path)
     assert params_sha256(read_gains(tmp_path / "g.json")[0]) == params_sha256(CONTROL)
 
 
-def _rule_rates():
+def _script(name: str):
+    """A module of scripts/ (not a package), loaded from its file."""
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "scripts" / "rule_rates.py"
-    spec = importlib.util.spec_from_file_location("rule_rates", path)
+    path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
@@ -729,7 +726,7 @@ def test_rule_rates_counts_each_clause_over_its_own_states():
     every state, perturbation rollouts only over the first n_perturbed states (their
     unperturbed row included), feedback rows and the Table 3 row apart. Synthetic rows, counted
     by hand."""
-    rr = _rule_rates()
+    rr = _script("rule_rates")
 
     def row(seed, kind="unperturbed", feedback=0.0, passed=True, fell=False, kept=True):
         return {"gait": "walk", "seed": seed, "kind": kind, "feedback": feedback,
@@ -754,7 +751,7 @@ def test_rule_rates_counts_each_clause_over_its_own_states():
 def test_rule_rates_refuses_the_tuning_and_test_states(monkeypatch, capsys):
     """A rule counted over tuning states (1000-1099) or the tests' (10-19) would not be a rule:
     refused with a usage error before any rollout."""
-    rr = _rule_rates()
+    rr = _script("rule_rates")
     for first in ("1090", "5", "15"):
         monkeypatch.setattr("sys.argv", ["rule_rates.py", "x.json", "--first", first])
         with pytest.raises(SystemExit) as e:
