@@ -13,6 +13,10 @@ Sensors, per leg l (0 left, 1 right), measured at every control tick:
     q_l = c_l theta_l       the contact-gated thigh angle: theta_l the thigh's angle from the
                             vertical in the world (rad, > 0 forward), c_l = 1 while the foot
                             carries load (n_l > 0.05), else 0.
+and one feature of the rhythm, not of the body:
+    sigma                   the extensors' left-right synchrony in [0, 1] that the controller
+                            measures from the network's own activations (1 in phase, 0 in
+                            antiphase), at the tick before.
 Cells in the order LF, RF, LE, RE (flexor and extensor of the left and right ankle); for leg
 l its flexor is cell l and its extensor cell 2 + l. One gain K >= 0 scales every pathway.
 
@@ -29,7 +33,18 @@ at K = 0.01 between them):
     so standing on both feet leaves the paper's rhythm;
   "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2);
   "reset": a touchdown pulse (phase resetting, Aoi & Tsuchiya): dv_{2+l}/dt += K p_l,
-    dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0.
+    dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0;
+  "angle_alternating" (session 39; measured, not chosen): the angle form scaled by the
+    rhythm's alternation,
+      dv_l/dt += K (1 - sigma) (-q_l / THETA_REF),  dv_{2+l}/dt += -K (1 - sigma) (-q_l / THETA_REF),
+    sigma in [0, 1] the extensors' left-right synchrony that the controller measures from the
+    network's own activations at the tick before (envs.control.controller, step 1: 0 when the
+    legs' extensors alternate, 1 when they burst together). Taga's pathway tells a leg behind
+    the hip that it is time to swing: a rhythm of alternating legs. In the jump's and the hop's
+    rhythms both legs stand together with their thighs ahead of the vertical (the hop's stance
+    thigh 0.18 rad on average, Table 3 state), and the angle form feeds every cell a steady
+    current that pulls each flexor away from its co-active extensor: at K = 0.05 the hop's
+    network is named none from all of 20 tuning states (apex 3.3 cm); gated, it stays a hop.
   scripts/feedback_choice.py scores every form at K = 0.01-0.1 (the pulse 0.05-0.2) by the
   push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
   after 5.5 s, each held 0.2 s as SCONE's tutorial holds them), keeping only gains at which
@@ -98,14 +113,21 @@ KIND_ML_ANGLE = 4
 # ... and a touchdown pulse (phase resetting, Aoi & Tsuchiya): for RESET_S after leg l's foot
 # lands, its extensor receives +K and its flexor -K.
 KIND_ML_RESET = 5
+# ... and Taga's angle in alternating rhythms only: the angle form scaled by 1 - sigma, sigma the
+# left-right synchrony of the extensors that the controller measures from the CPG's own
+# activations (sensor slot SYNC_SLOT; 0 in antiphase, 1 in phase).
+KIND_ML_ANGLE_ALT = 6
 ML_FORMS = {"load": KIND_ML, "load_antagonist": KIND_ML_ANTAGONIST, "angle": KIND_ML_ANGLE,
-            "reset": KIND_ML_RESET}
-ML_CODES = (KIND_ML, KIND_ML_ANTAGONIST, KIND_ML_ANGLE, KIND_ML_RESET)
+            "reset": KIND_ML_RESET, "angle_alternating": KIND_ML_ANGLE_ALT}
+ML_CODES = (KIND_ML, KIND_ML_ANTAGONIST, KIND_ML_ANGLE, KIND_ML_RESET, KIND_ML_ANGLE_ALT)
 RESET_S = 0.05  # s: length of the touchdown pulse
 # The sensor vector the controller fills (envs.control_kernel.body_sensors): n_L, n_R, q_L,
 # q_R, the touchdown pulses p_L, p_R (1 during RESET_S after a landing), then the detector's
-# memory (time left of each pulse, each foot's last contact state).
-N_SENSORS = 10
+# memory (time left of each pulse, each foot's last contact state), then the extensors'
+# left-right synchrony sigma in [0, 1] that the controller measured at the tick before (its
+# CPG feature, from the network's own activations; read by "angle_alternating" only).
+N_SENSORS = 11
+SYNC_SLOT = 10
 LOAD_CONTACT = 0.05  # body weights: a foot carrying more is on the ground (gate c_l)
 THETA_REF = 0.3  # rad: Taga's thigh-angle scale for the Matsuoka pathway
 MAX_GAIN = {"ml": 1.0, "hopf": 50.0, "matsuoka": 5.0}  # beyond these the network is swamped
@@ -256,6 +278,10 @@ def inputs(code, K, y, sensors, inp):
             x, v = y[2 + leg], y[6 + leg]
             r = math.sqrt(x * x + v * v) + 1e-12
             inp[2 + leg] = K * n * x / r
+        elif code == KIND_ML_ANGLE_ALT:  # Taga's gated thigh angle, alternating rhythms
+            s = -sensors[2 + leg] / THETA_REF * (1.0 - min(max(sensors[SYNC_SLOT], 0.0), 1.0))
+            inp[leg] = K * s
+            inp[2 + leg] = -K * s
         else:  # Matsuoka, and the Morris-Lecar angle form: Taga's gated thigh angle
             s = -sensors[2 + leg] / THETA_REF
             inp[leg] = K * s

@@ -6,7 +6,8 @@ in [--first, --first + --n) and is validated for 20 s after settling, as ``cpgbi
 does, with the committed gains or --gains FILE:
 
     python scripts/census.py walk,run,jump,hop --first 3000 --n 30 [--gains FILE]
-                             [--friction F] [--push T I [--push-s S]] [--feedback [K]] [-v]
+                             [--friction F] [--push T I [--push-s S]] [--feedback [K]]
+                             [--feedback-form FORM] [-v]
 
 --friction scales the floor's friction, --push gives the torso a horizontal impulse of I N s
 at T s (simulation time, settling included), its force held --push-s s (default 0.2, as
@@ -30,14 +31,15 @@ SECONDS = 20.0  # validate's measured window (after its 2 s of settling)
 def one(job):
     """One preset from one random CPG state under one perturbation: (gait, seed, summary,
     failed criteria)."""
-    gait, seed, gains, friction, push, feedback = job
+    gait, seed, gains, friction, push, feedback, *form = job  # form: optional, Morris-Lecar
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL, read_gains
     from cpgbiped.envs.gaits.validate import validate
 
     params = read_gains(gains)[0] if gains else CONTROL
     s = validate(build("ml", gait, seed=seed), gait, SECONDS, params=params,
-                 friction_scale=friction, push=push, feedback=feedback).summary()
+                 friction_scale=friction, push=push, feedback=feedback,
+                 feedback_form=form[0] if form else None).summary()
     return gait, seed, s, s["failures"]
 
 
@@ -61,6 +63,10 @@ def main() -> None:
     ap.add_argument("--feedback", nargs="?", const="recommended", default=None, metavar="K",
                     help="feed the body's sensors back into the CPG: alone the recommended "
                          "gain, or K (default: open loop)")
+    ap.add_argument("--feedback-form", default=None, metavar="FORM",
+                    help="with --feedback: a Morris-Lecar pathway other than the chosen one "
+                         "(cpg.feedback.ML_FORMS: load, load_antagonist, angle, reset, "
+                         "angle_alternating)")
     ap.add_argument("-v", action="store_true", help="one line per failing rollout")
     a = ap.parse_args()
     from cpgbiped.cpg.errors import InputError
@@ -82,7 +88,12 @@ def main() -> None:
             check_push(push, SETTLE_S + SECONDS)
         except InputError as e:
             ap.error(str(e))
-    jobs = [(g, s, a.gains, a.friction, push, feedback) for g in gaits
+    if a.feedback_form is not None:
+        from cpgbiped.cpg.feedback import ML_FORMS
+
+        if a.feedback_form not in ML_FORMS:
+            ap.error(f"--feedback-form: one of {', '.join(ML_FORMS)}, got {a.feedback_form!r}")
+    jobs = [(g, s, a.gains, a.friction, push, feedback, a.feedback_form) for g in gaits
             for s in range(a.first, a.first + a.n)]
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
         res = list(ex.map(one, jobs))

@@ -7,7 +7,7 @@ transition works. Each ordered pair starts from the random CPG state of each see
 and with the recommended feedback), as ``cpgbiped transition --seed S`` does:
 
     python scripts/transition_census.py [--pairs in-family|cross|all] [--first 3000] [--n 30]
-                                        [--at 8] [--json FILE]
+                                        [--at 8] [--gains FILE] [--json FILE]
 
 A transition counts as switched as the tests count it: no fall, the physical gait before the
 change is A, and the settled gait after it is B (``cycles_to_switch`` set; the tests also ask
@@ -32,13 +32,16 @@ CROSS = tuple(p for p in PAIRS if p not in _FAMILY)
 
 def one(job):
     """One transition from one random CPG state: (a, b, ramp, K, seed, outcome dict)."""
-    a, b, ramp, K, seed, at = job
+    a, b, ramp, K, seed, at, gains = job
     import numba
 
     numba.set_num_threads(1)  # two workers share two cores
+    from cpgbiped.envs.control.controller import CONTROL, read_gains
     from cpgbiped.envs.experiments.transition import default_seconds, transition
 
-    res, *_ = transition("ml", a, b, at, ramp, default_seconds(a, b, at, ramp), K, seed=seed)
+    params = read_gains(gains)[0] if gains else CONTROL
+    res, *_ = transition("ml", a, b, at, ramp, default_seconds(a, b, at, ramp), K, seed=seed,
+                         params=params)
     n = res["cycles_to_switch"]
     k = res["network_alone"]["cycles_to_switch"]  # the same change without a body
     net_alone = (k is not None and k <= 4) if K == 0 else None
@@ -56,11 +59,13 @@ def main() -> None:
     ap.add_argument("--first", type=int, default=3000)
     ap.add_argument("--n", type=int, default=30)
     ap.add_argument("--at", type=float, default=8.0, help="time of the change, s (default 8)")
+    ap.add_argument("--gains", default=None, metavar="FILE",
+                    help="a gains file (default: the committed one)")
     ap.add_argument("--json", default=None, metavar="FILE", help="also write every outcome")
     a = ap.parse_args()
     pairs = {"in-family": IN_FAMILY, "cross": CROSS, "all": IN_FAMILY + CROSS}[a.pairs]
     ways = [(r, k) for r in (0.0, 2.0) for k in (0.0, RECOMMENDED["ml"])]
-    jobs = [(x, y, r, k, s, a.at) for x, y in pairs for r, k in ways
+    jobs = [(x, y, r, k, s, a.at, a.gains) for x, y in pairs for r, k in ways
             for s in range(a.first, a.first + a.n)]
     with ProcessPoolExecutor(min(2, os.cpu_count() or 1)) as ex:
         res = list(ex.map(one, jobs, chunksize=4))

@@ -139,6 +139,43 @@ def test_the_thigh_angle_pathway_is_gated_by_ground_contact():
         assert np.array_equal(fb[:, 0], -fb[:, 1])
 
 
+def test_the_alternating_angle_form_is_the_angle_form_scaled_by_one_minus_the_synchrony():
+    """"angle_alternating" (cpg/feedback.py): each cell receives the angle form's term times
+    (1 - sigma), sigma the rhythm's synchrony in the sensor slot SYNC_SLOT, clipped to [0, 1]."""
+    from cpgbiped.cpg.feedback import KIND_ML_ANGLE, ML_FORMS, SYNC_SLOT, THETA_REF, inputs
+
+    y = np.zeros(8)
+    for sigma in (0.0, 0.25, 1.0, 1.7, -0.3):
+        sensors = np.zeros(11)
+        sensors[:4] = (0.8, 0.0, 0.21, -0.12)  # loads, then contact-gated thigh angles (rad)
+        sensors[SYNC_SLOT] = sigma
+        gated, plain = np.zeros(4), np.zeros(4)
+        inputs(ML_FORMS["angle_alternating"], 0.05, y, sensors, gated)
+        inputs(KIND_ML_ANGLE, 0.05, y, sensors, plain)
+        scale = 1.0 - min(max(sigma, 0.0), 1.0)
+        expect = 0.05 * scale * np.array([-0.21, 0.12, 0.21, -0.12]) / THETA_REF
+        assert np.allclose(gated, expect, atol=1e-15)
+        assert np.allclose(gated, scale * plain, atol=1e-15)
+
+
+def test_the_alternating_angle_form_leaves_the_hop_s_synchronous_network_alone():
+    """In the hop's rhythm both legs' extensors burst together (sigma -> 1), so the gated form
+    feeds the cells almost nothing once the controller has seen the rhythm, and the network
+    stays the open loop's hop; the plain angle form at the same K feeds the standing thighs'
+    angle into every cell (measured, session 39: it makes the hop's network none from every
+    one of 20 tuning states)."""
+    from cpgbiped.envs.gaits.validate import validate
+
+    net = build("ml", "hop")
+    gated = validate(net, "hop", 8.0, feedback=0.05, feedback_form="angle_alternating")
+    plain = validate(net, "hop", 8.0, feedback=0.05, feedback_form="angle")
+    late = gated.recording.t > 4.0
+    fb_gated = np.abs(gated.recording.feedback[late]).mean()
+    fb_plain = np.abs(plain.recording.feedback[plain.recording.t > 4.0]).mean()
+    assert fb_gated < 0.1 * fb_plain, (fb_gated, fb_plain)
+    assert gated.summary()["cpg_gait"] == "hop"
+
+
 def test_the_phase_response_moves_the_cpg_only_with_feedback():
     """Open loop the network never hears the body: a push leaves its phase exactly where it
     was. With Tegotae feedback (Hopf run, K = 3) a 10 N s push moves it, at each phase tried,

@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit
 
 from cpgbiped.cpg.feedback import LOAD_CONTACT, RESET_S
+from cpgbiped.cpg.feedback import SYNC_SLOT as FB_SYNC_SLOT
 from cpgbiped.cpg.feedback import advance as fb_advance
 from cpgbiped.cpg.feedback import blend_at as fb_blend_at
 from cpgbiped.cpg.feedback import inputs as fb_inputs
@@ -505,7 +506,8 @@ def body_sensors(qpos, sens, ix, weight_n, tick_s, out):
     normal loads in body weights (weight_n newtons), the contact-gated thigh angles (rad from
     the vertical, > 0 forward), the touchdown pulses (1 for RESET_S after a foot lands, the
     load crossing LOAD_CONTACT upwards), then the detector's memory (time left of each pulse,
-    each foot's contact at the last tick). Called once per tick of ``tick_s`` seconds."""
+    each foot's contact at the last tick); :func:`step_closed` then adds the rhythm's
+    synchrony sigma (cpg.feedback.SYNC_SLOT). Called once per tick of ``tick_s`` seconds."""
     for i in range(2):
         n = abs(sens[ix[IX_FORCE + i]]) / weight_n
         out[i] = n
@@ -537,6 +539,7 @@ def step_closed(advance_first, code, NP, P_ab, knots, y, K, n_sub, h, noise, ste
         if not fb_advance(code, NP, y, K, sensors, n_sub, h, noise, step0, fb, scratch):
             return False
     body_sensors(qpos, sens, ix, weight_n, tick_s, sensors)
+    sensors[FB_SYNC_SLOT] = S[S_SYNC]  # the rhythm's synchrony as measured at the tick before
     fb_inputs(code, K, y, sensors, fb)
     fb_outputs(code, y, act_c, act_w, v, a)
     control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, ctrl)

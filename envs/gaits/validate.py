@@ -87,16 +87,19 @@ def validate(network: Network, gait: str | None = None, seconds: float = 20.0, *
              friction_scale: float = 1.0, push: tuple[float, ...] | None = None,
              settle_s: float = SETTLE_S, stop_on_fall: bool = True, ankle_drive: bool = True,
              params: ControlParams = CONTROL, to: Network | None = None,
-             change: Schedule | None = None, feedback: float = 0.0) -> Validation:
+             change: Schedule | None = None, feedback: float = 0.0,
+             feedback_form: str | None = None) -> Validation:
     """Roll out ``settle_s + seconds`` and measure the gait over the last ``seconds``;
-    ``feedback``: the gain K of the body's feedback into the CPG (0: open loop); ``push``:
+    ``feedback``: the gain K of the body's feedback into the CPG (0: open loop), through the
+    network's chosen pathway or, Morris-Lecar only, ``feedback_form`` (one of
+    cpg.feedback.ML_FORMS); ``push``:
     (time s, impulse N s[, held s]) as :func:`rollout` takes it (held one control tick when
     no duration is given; ``cpgbiped validate --push`` holds it 0.2 s)."""
     check_gait(gait)
     seconds = check_seconds(seconds)
     rec = rollout(network, seconds + settle_s, params, friction_scale=friction_scale, push=push,
                   stop_on_fall=stop_on_fall, ankle_drive=ankle_drive, to=to, change=change,
-                  feedback=feedback)
+                  feedback=feedback, feedback_form=feedback_form)
     return measure_recording(network, gait, rec, settle_s, ankle_drive)
 
 
