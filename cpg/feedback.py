@@ -40,11 +40,13 @@ at K = 0.01 between them):
     sigma in [0, 1] the extensors' left-right synchrony that the controller measures from the
     network's own activations at the tick before (envs.control.controller, step 1: 0 when the
     legs' extensors alternate, 1 when they burst together). Taga's pathway tells a leg behind
-    the hip that it is time to swing: a rhythm of alternating legs. In the jump's and the hop's
-    rhythms both legs stand together with their thighs ahead of the vertical (the hop's stance
-    thigh 0.18 rad on average, Table 3 state), and the angle form feeds every cell a steady
-    current that pulls each flexor away from its co-active extensor: at K = 0.05 the hop's
-    network is named none from all of 20 tuning states (apex 3.3 cm); gated, it stays a hop.
+    the hip that it is time to swing: a rhythm of alternating legs. In the hop's rhythm both
+    legs stand together with their thighs ahead of the vertical (0.18 rad on average in
+    stance, Table 3 state), and the angle form feeds all four co-active cells a steady current
+    that pulls each flexor away from its extensor: at K = 0.05 the CPG classifier names the
+    hop's network none from 19 of 20 tuning states (CPG seeds 1000-1019, apex 3.2-3.4 cm);
+    gated, 19 of 20 pass every hop criterion. Not chosen: feedback_choice.py (below) has not
+    scored it (docs/JOURNAL.md, session 39, for what it did on unused states).
   scripts/feedback_choice.py scores every form at K = 0.01-0.1 (the pulse 0.05-0.2) by the
   push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
   after 5.5 s, each held 0.2 s as SCONE's tutorial holds them), keeping only gains at which

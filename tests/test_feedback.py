@@ -162,8 +162,8 @@ def test_the_alternating_angle_form_leaves_the_hop_s_synchronous_network_alone()
     """In the hop's rhythm both legs' extensors burst together (sigma -> 1), so the gated form
     feeds the cells almost nothing once the controller has seen the rhythm, and the network
     stays the open loop's hop; the plain angle form at the same K feeds the standing thighs'
-    angle into every cell (measured, session 39: it makes the hop's network none from every
-    one of 20 tuning states)."""
+    angle into every cell (measured, session 39: the CPG classifier names the hop's network
+    none from 19 of 20 tuning states)."""
     from cpgbiped.envs.gaits.validate import validate
 
     net = build("ml", "hop")
