@@ -280,12 +280,12 @@ def inputs(code, K, y, sensors, inp):
             x, v = y[2 + leg], y[6 + leg]
             r = math.sqrt(x * x + v * v) + 1e-12
             inp[2 + leg] = K * n * x / r
-        elif code == KIND_ML_ANGLE_ALT:  # Taga's gated thigh angle, alternating rhythms
-            s = -sensors[2 + leg] / THETA_REF * (1.0 - min(max(sensors[SYNC_SLOT], 0.0), 1.0))
-            inp[leg] = K * s
-            inp[2 + leg] = -K * s
-        else:  # Matsuoka, and the Morris-Lecar angle form: Taga's gated thigh angle
-            s = -sensors[2 + leg] / THETA_REF
+        else:  # Matsuoka, and the Morris-Lecar angle forms: Taga's gated thigh angle (in
+            # alternating rhythms only: scaled by 1 - sigma; x 1.0 is exact for the others)
+            alt = 1.0
+            if code == KIND_ML_ANGLE_ALT:
+                alt = 1.0 - min(max(sensors[SYNC_SLOT], 0.0), 1.0)
+            s = -sensors[2 + leg] / THETA_REF * alt
             inp[leg] = K * s
             inp[2 + leg] = -K * s
 

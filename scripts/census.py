@@ -31,7 +31,7 @@ SECONDS = 20.0  # validate's measured window (after its 2 s of settling)
 def one(job):
     """One preset from one random CPG state under one perturbation: (gait, seed, summary,
     failed criteria)."""
-    gait, seed, gains, friction, push, feedback, *form = job  # form: optional, Morris-Lecar
+    gait, seed, gains, friction, push, feedback, form = job  # form: None, the chosen pathway
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL, read_gains
     from cpgbiped.envs.gaits.validate import validate
@@ -39,7 +39,7 @@ def one(job):
     params = read_gains(gains)[0] if gains else CONTROL
     s = validate(build("ml", gait, seed=seed), gait, SECONDS, params=params,
                  friction_scale=friction, push=push, feedback=feedback,
-                 feedback_form=form[0] if form else None).summary()
+                 feedback_form=form).summary()
     return gait, seed, s, s["failures"]
 
 
@@ -65,8 +65,7 @@ def main() -> None:
                          "gain, or K (default: open loop)")
     ap.add_argument("--feedback-form", default=None, metavar="FORM",
                     help="with --feedback: a Morris-Lecar pathway other than the chosen one "
-                         "(cpg.feedback.ML_FORMS: load, load_antagonist, angle, reset, "
-                         "angle_alternating)")
+                         "(one of cpg.feedback.ML_FORMS)")
     ap.add_argument("-v", action="store_true", help="one line per failing rollout")
     a = ap.parse_args()
     from cpgbiped.cpg.errors import InputError

@@ -72,7 +72,7 @@ def _one(job):
     gains, seed, cond = job
     kw = CONDITIONS[cond]
     _, _, s, _ = census_one(("hop", seed, gains, kw.get("friction_scale", 1.0), kw.get("push"),
-                             0.0))
+                             0.0, None))
     return bool(s["passed"]), bool(s["physical_gait"] == "hop" and not s["fell"])
 
 

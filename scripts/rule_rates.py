@@ -58,7 +58,7 @@ def one(job):
     gains, gait, seed, kind, feedback = job
     kw = PERTURBATIONS[kind]
     _, _, s, _ = census_one((gait, seed, gains, kw.get("friction_scale", 1.0), kw.get("push"),
-                             feedback))
+                             feedback, None))
     return {"gait": gait, "seed": seed, "kind": kind, "feedback": feedback,
             "passed": bool(s["passed"]), "fell": bool(s["fell"]),
             "kept": bool(s["physical_gait"] == gait and not s["fell"])}
@@ -142,9 +142,7 @@ def main() -> None:
               file=sys.stderr)
     from cpgbiped.cpg.errors import InputError
     from cpgbiped.cpg.feedback import RECOMMENDED
-    from cpgbiped.envs.control.controller import read_gains
-
-    from cpgbiped.envs.control.controller import GAINS_FILE
+    from cpgbiped.envs.control.controller import GAINS_FILE, read_gains
 
     a.baseline = str(a.baseline or GAINS_FILE)
     for gains in (a.baseline, a.candidate):  # both readable before any rollout starts

@@ -61,8 +61,8 @@ def main() -> None:
         for tau in (float(x) for x in a.candidates.split(",")):
             g = str(Path(tmp) / f"gains_{tau:g}.json")
             set_startup(a.live, startup_from, tau, g, "candidate")
-            jobs = ([("walk", s, g, 1.0, None) for s in WALK_SEEDS]
-                    + [("jump", s, g, 1.0, None) for s in JUMP_SEEDS])
+            jobs = ([("walk", s, g, 1.0, None, 0.0, None) for s in WALK_SEEDS]
+                    + [("jump", s, g, 1.0, None, 0.0, None) for s in JUMP_SEEDS])
             res = list(ex.map(one, jobs))
             walk = [r for r in res if r[0] == "walk"]
             jump = [r for r in res if r[0] == "jump"]

@@ -50,7 +50,7 @@ from cpgbiped.cpg.gaits import named_windows, settled_at
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import PRESETS, build
 
-from cpgbiped.envs.control.controller import CONTROL
+from cpgbiped.envs.control.controller import CONTROL, ControlParams
 from cpgbiped.envs.gaits.criteria import SETTLE_S
 from cpgbiped.envs.simulation.rollout import check_seconds, rollout, window
 from cpgbiped.envs.gaits.validate import measure_recording
@@ -150,7 +150,7 @@ def network_alone(kind: str, a: str, b: str, at_s: float, ramp_s: float,
 
 def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0,
                seconds: float = 20.0, feedback: float = 0.0, poses: bool = False,
-               seed: int | None = None, params=CONTROL):
+               seed: int | None = None, params: ControlParams = CONTROL):
     """(result dict, recording, the network A, the network B). ``seed``: A starts from the
     random initial CPG state drawn from this seed (None: its Table 3 state); B lends only its
     parameters, so its state is never used. ``params``: the controller's parameters (default
