@@ -21,9 +21,10 @@ Cells in the order LF, RF, LE, RE (flexor and extensor of the left and right ank
 l its flexor is cell l and its extensor cell 2 + l. One gain K >= 0 scales every pathway.
 
 Morris-Lecar: four pathways were built and measured (input currents in model units); the
-chosen one is ``CHOICE["ml"]``, read from the data file below (Taga's "angle" at K = 0.01 since
-the walk's stance knee of 2026-12-04, as before the walk corner's push stages; "load_antagonist"
-at K = 0.01 between them):
+chosen one is ``CHOICE["ml"]``, read from the data file below ("angle_alternating" at K = 0.03
+since session 40, 2026-12-06; Taga's "angle" at K = 0.01 from the walk's stance knee of
+2026-12-04 to it, as before the walk corner's push stages; "load_antagonist" at K = 0.01
+between them):
   "angle": contact-gated thigh angle, a current into each cell of leg l:
     dv_l/dt += K (-q_l / THETA_REF),    dv_{2+l}/dt += -K (-q_l / THETA_REF)
     (a stance leg carried behind the hip depolarises its flexor and hyperpolarises its
@@ -34,7 +35,7 @@ at K = 0.01 between them):
   "load_antagonist": the same, and each flexor receives the opposite, -K (n_l - 1/2);
   "reset": a touchdown pulse (phase resetting, Aoi & Tsuchiya): dv_{2+l}/dt += K p_l,
     dv_l/dt -= K p_l, with p_l = 1 for RESET_S = 50 ms after leg l's foot lands, else 0;
-  "angle_alternating" (session 39; measured, not chosen): the angle form scaled by the
+  "angle_alternating" (built in session 39, chosen in session 40): the angle form scaled by the
     rhythm's alternation,
       dv_l/dt += K (1 - sigma) (-q_l / THETA_REF),  dv_{2+l}/dt += -K (1 - sigma) (-q_l / THETA_REF),
     sigma in [0, 1] the extensors' left-right synchrony that the controller measures from the
@@ -45,16 +46,19 @@ at K = 0.01 between them):
     stance, Table 3 state), and the angle form feeds all four co-active cells a steady current
     that pulls each flexor away from its extensor: at K = 0.05 the CPG classifier names the
     hop's network none from 19 of 20 tuning states (CPG seeds 1000-1019, apex 3.2-3.4 cm);
-    gated, 19 of 20 pass every hop criterion. Not chosen: feedback_choice.py (below) has not
-    scored it (docs/JOURNAL.md, session 39, for what it did on unused states).
+    gated, 19 of 20 pass every hop criterion.
   scripts/feedback_choice.py scores every form at K = 0.01-0.1 (the pulse 0.05-0.2) by the
   push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
   after 5.5 s, each held 0.2 s as SCONE's tutorial holds them), keeping only gains at which
-  no rollout falls, the CPG classifier still names the gait, and each preset
-  passes its gait's criteria in as many seeds as open loop. On today's gains "angle" at
-  K = 0.01 scores 177.5 N s (open loop 167.5; "load_antagonist" 155, "load" 152.5; at 0.03
-  and 0.05 "angle" scores 177.5 and 297.5 but the run's Froude number sinks below 0.25:
-  inadmissible). Scored with one-tick blows of the same impulses (the form until
+  no rollout of any of the four presets falls, the CPG classifier still names the gait, and
+  each preset passes its gait's criteria in as many seeds as open loop. On the gains of
+  2026-12-06 "angle_alternating" at K = 0.03 scores 285 N s (open loop 182.5; "angle" at
+  K = 0.01 192.5 and at 0.03 252.5, both inadmissible: the hop falls in a seed and passes in
+  2 of 4, open loop 3); checked on unused states before adoption (docs/JOURNAL.md, session
+  40). On the gains of 2026-12-04, with the walk and the run only, "angle" at K = 0.01 scored
+  177.5 N s (open loop 167.5; "load_antagonist" 155, "load" 152.5; at 0.03 and 0.05 "angle"
+  scored 177.5 and 297.5 but the run's Froude number sank below 0.25: inadmissible). Scored
+  with one-tick blows of the same impulses (the form until
   2026-12-04) the choice was the same: "angle" at
   K = 0.01 scored 145 N s (open loop 145, both passing the criteria in 8 of 8 rollouts) and
   "load_antagonist" at K = 0.01 140 (8 of 8); at K = 0.03 "load_antagonist" 162.5 and

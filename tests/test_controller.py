@@ -441,8 +441,9 @@ def test_sync_land_acts_only_on_a_lone_foot_and_keeps_stumbling_hops_up():
     kept = 0
     for seed in (1046, 1049, 1052, 1060, 1094):
         net = build("ml", "hop", seed=seed)
-        off = rollout(net, 10.0, replace(CONTROL, sync_land=0.0), poses=False, feedback=0.01)
-        on = rollout(net, 10.0, CONTROL, poses=False, feedback=0.01)
+        off = rollout(net, 10.0, replace(CONTROL, sync_land=0.0), poses=False, feedback=0.01,
+                      feedback_form="angle")  # the tuning conditions' loop (TUNING_FEEDBACK)
+        on = rollout(net, 10.0, CONTROL, poses=False, feedback=0.01, feedback_form="angle")
         assert off.fell_at is not None and 4.9 <= off.fell_at <= 5.6
         n = min(len(off.t), len(on.t))
         k = int(np.argmax(np.any(off.ctrl[:n] != on.ctrl[:n], axis=1)))

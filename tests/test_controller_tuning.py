@@ -286,14 +286,17 @@ def test_conditions_can_be_picked_by_number():
 
 def test_a_transition_condition_is_the_transition_command_s_rollout_judged_as_the_partner():
     """Condition 44 (the walk network ramped to the run's over 2 s at 7 s, with the tuning
-    feedback) scores the walk's gains on the rollout that ``cpgbiped transition --from walk
-    --to run --at 7 --ramp 2 --feedback 0.01 --seed 1083`` makes (the same fall, or none), judged
+    feedback, Taga's thigh angle at K = 0.01) scores the walk's gains on the rollout that
+    ``transition("ml", "walk", "run", 7, 2, feedback=0.01, feedback_form="angle", seed=1083)``
+    makes (``cpgbiped transition --from walk --to run --at 7 --ramp 2 --feedback 0.01 --seed
+    1083`` while that pathway was the recommended one; the same fall, or none), judged
     as the run from 4 run periods after the change began, for 5 s; its cost is the run's
     rollout cost over that window (envs.experiments.transition, computed independently)."""
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import params_array
     from cpgbiped.envs.experiments.transition import transition
-    from cpgbiped.envs.search.controller_tuning import ControllerTuningProblem, condition_trial
+    from cpgbiped.envs.search.controller_tuning import (TUNING_FEEDBACK, ControllerTuningProblem,
+                                                        condition_trial)
     from cpgbiped.envs.simulation.trials import run_control_trial
 
     c = tuning_conditions(MAX_CONDITIONS)[43]
@@ -306,7 +309,7 @@ def test_a_transition_condition_is_the_transition_command_s_rollout_judged_as_th
     assert s["judge"] == {"gait": "run", "from_s": pytest.approx(7.0 + 4 * T), "seconds": 5.0}
     assert s["total_s"] == pytest.approx(7.0 + 4 * T + 5.0)
     res, *_ = transition("ml", "walk", "run", 7.0, 2.0, s["total_s"], feedback=0.01,
-                         seed=c["cpg_seed"])
+                         seed=c["cpg_seed"], feedback_form=TUNING_FEEDBACK[0])
     assert s["fell"] == res["fell"]
     if res["fell"]:
         assert s["survived_s"] == pytest.approx(res["fell_at_s"])

@@ -159,19 +159,23 @@ K_FB = RECOMMENDED["ml"]
 IN_FAMILY_CASES = [(a, b, r, k) for a, b in sorted(IN_FAMILY) for r in (0.0, 2.0)
                    for k in (0.0, K_FB)]
 IN_FAMILY_SHORTFALL = {
-    # since sync_land (2026-12-06, session 38, scripts/sync_land.py; README "Transitions") 6 of
-    # 16 pass: walk -> run as an open-loop step, run -> walk as a step with feedback, hop ->
-    # jump as a step and a ramp with feedback, jump -> hop as a step open loop and with
-    # feedback; K_FB Taga's thigh angle. From the hop's corner and the walk's start-up corner
-    # (session 35) to it 5 of 16: jump -> hop as a ramp with feedback instead of its steps. Before it (the run's swing clearance, session 34) 6 of 16: walk -> run as a
-    # step either way, run -> walk and hop -> jump as a step and a ramp with feedback.
-    ("walk", "run", 0.0, K_FB): "falls at 10.4 s, 2.4 s after the change (a run 1 CPG cycle "
-                                "after it before the hop's corner)",
+    # Since the recommended feedback became Taga's angle in alternating rhythms at K = 0.03
+    # (session 40, scripts/feedback_choice.py) 4 of 16 pass: walk -> run and jump -> hop as
+    # open-loop steps, run -> walk as a step and a ramp with feedback. With Taga's thigh angle
+    # at K = 0.01 (sessions 38-39) 6 of 16: walk -> run as an open-loop step, run -> walk as a
+    # step with feedback, hop -> jump as a step and a ramp with feedback, jump -> hop as a step
+    # either way; the gated pathway is near zero in the hop's and the jump's rhythms, so it no
+    # longer carries hop -> jump in time (over 30 random states it still switches in 22 and 18:
+    # README "Transitions").
+    ("walk", "run", 0.0, K_FB): "falls at 9.8 s, 1.8 s after the change; the walk is named none "
+                                "over its last 5 cycles before it (10.4 s at K = 0.01)",
     # walk -> run as an open-loop ramp: the network alone is still a walk 2-5 run periods
     # after the change began (test_network.py: ..._keeps_a_walk_past_four_cycles)
     ("walk", "run", 2.0, 0.0): "falls at 12.2 s, 2.2 s after the ramp ends; the network alone "
                                "is a walk to the 5th cycle",
-    ("walk", "run", 2.0, K_FB): "falls at 11.4 s, 1.4 s after the ramp ends",
+    ("walk", "run", 2.0, K_FB): "a run 3 CPG cycles after the change, no fall, but the walk is "
+                                "named none over its last 5 cycles before it, the closed loop's "
+                                "start-up (fell at 11.4 s at K = 0.01)",
     # run -> walk open loop: the network's own extensors burst in phase for cycles after the
     # change (test_from_the_run_to_the_walk_the_open_loop_network_hops_and_feedback_undoes_it)
     ("run", "walk", 0.0, 0.0): "falls at 9.8 s, 1.8 s after the change (named a hop after it, "
@@ -179,22 +183,19 @@ IN_FAMILY_SHORTFALL = {
                                "together",
     ("run", "walk", 2.0, 0.0): "falls at 10.3 s, as the ramp ends; the network bursts both "
                                "legs together",
-    ("run", "walk", 2.0, K_FB): "a walk 5 CPG cycles after the change, no fall (3 before the "
-                                "hop's corner)",
-    # jump -> hop fell all four ways from the jump corner's balance reference (session 32) to
-    # the hop's corner; since sync_land (session 38, scripts/sync_land.py) it passes as a step
-    # either way (a hop 1 CPG cycle after the change; both fell at 12.0 and 12.5 s before) and
-    # the ramp with feedback takes 5 cycles (4 before)
+    ("jump", "hop", 0.0, K_FB): "a hop 9 CPG cycles after the change, no fall (1 at K = 0.01)",
     ("jump", "hop", 2.0, 0.0): "falls at 20.1 s, 10.1 s after the ramp ends (at 14.1 s before "
                                "sync_land)",
-    ("jump", "hop", 2.0, K_FB): "a hop 5 CPG cycles after the change, no fall (4 before "
-                                "sync_land)",
+    ("jump", "hop", 2.0, K_FB): "a hop 10 CPG cycles after the change, no fall (5 at K = 0.01)",
     # hop -> jump open loop: the network alone stays a hop for 12 cycles and more
     # (test_network.py: ..._the_network_stays_a_hop_for_a_dozen_cycles)
     ("hop", "jump", 0.0, 0.0): "no fall, still a hop 12 s after the change; the network alone "
                                "is a hop for 12 cycles",
+    ("hop", "jump", 0.0, K_FB): "a jump 8 CPG cycles after the change, no fall (a skip after 2 "
+                                "and a jump from 3 at K = 0.01)",
     ("hop", "jump", 2.0, 0.0): "no fall, still a hop 12 s after the change; the network alone "
                                "is a hop for 12 cycles",
+    ("hop", "jump", 2.0, K_FB): "a jump 5 CPG cycles after the change, no fall (1 at K = 0.01)",
 }
 
 
@@ -232,6 +233,10 @@ CROSS_SHORTFALL = {
     # fall all four ways at 8 s (each is reached at other change times, 9-14 s: README)
     # Since sync_land (session 38) walk -> hop (a ramp, 5 cycles) and run -> hop (a step, 5
     # cycles) are reached and run -> jump and hop -> run fall all four ways: 5 of 8 as before
+    # Since the gated angle at K = 0.03 became the recommended feedback (session 40) walk -> jump
+    # falls all four ways as well: 4 of 8 (walk -> hop, run -> hop, jump -> walk, hop -> walk)
+    ("walk", "jump"): "falls all four ways, at 9.6, 10.8, 10.6 and 11.8 s (reached as a ramp "
+                      "with feedback at K = 0.01, 23 cycles)",
     ("run", "jump"): "falls all four ways, at 9.2, 9.3, 11.3 and 10.8 s (step, step with "
                      "feedback, ramp, ramp with feedback)",
     ("jump", "run"): "falls all four ways, at 10.8, 10.6, 9.9 and 16.2 s",

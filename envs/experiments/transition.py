@@ -150,15 +150,19 @@ def network_alone(kind: str, a: str, b: str, at_s: float, ramp_s: float,
 
 def transition(kind: str, a: str, b: str, at_s: float = 8.0, ramp_s: float = 0.0,
                seconds: float = 20.0, feedback: float = 0.0, poses: bool = False,
-               seed: int | None = None, params: ControlParams = CONTROL):
+               seed: int | None = None, params: ControlParams = CONTROL,
+               feedback_form: str | None = None):
     """(result dict, recording, the network A, the network B). ``seed``: A starts from the
     random initial CPG state drawn from this seed (None: its Table 3 state); B lends only its
     parameters, so its state is never used. ``params``: the controller's parameters (default
-    the committed gains; a candidate's, to measure it as the committed ones are)."""
+    the committed gains; a candidate's, to measure it as the committed ones are).
+    ``feedback_form``: the Morris-Lecar pathway (cpg.feedback.ML_FORMS; None: the recommended
+    one), e.g. the tuning conditions' frozen pathway."""
     seconds = check_transition(kind, a, b, at_s, ramp_s, seconds)
     net, to = build(kind, a, seed=seed), build(kind, b)
     rec = rollout(net, seconds, params, to=to, change=Schedule.change(at_s, ramp_s),
-                  poses=poses, stop_on_fall=False, feedback=feedback)
+                  poses=poses, stop_on_fall=False, feedback=feedback,
+                  feedback_form=feedback_form)
     fell_at = rec.fell_at
     T = to.period_s()
     n_before = before_cycles(at_s, net.period_s())
