@@ -174,8 +174,9 @@ IN_FAMILY_SHORTFALL = {
     ("walk", "run", 2.0, 0.0): "falls at 12.2 s, 2.2 s after the ramp ends; the network alone "
                                "is a walk to the 5th cycle",
     ("walk", "run", 2.0, K_FB): "a run 3 CPG cycles after the change, no fall, but the walk is "
-                                "named none over its last 5 cycles before it, the closed loop's "
-                                "start-up (fell at 11.4 s at K = 0.01)",
+                                "named none over its last 5 cycles before it (0.79 m/s, left "
+                                "duty 0.550 against 0.55: a slower start; fell at 11.4 s at "
+                                "K = 0.01)",
     # run -> walk open loop: the network's own extensors burst in phase for cycles after the
     # change (test_from_the_run_to_the_walk_the_open_loop_network_hops_and_feedback_undoes_it)
     ("run", "walk", 0.0, 0.0): "falls at 9.8 s, 1.8 s after the change (named a hop after it, "
