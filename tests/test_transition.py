@@ -437,6 +437,35 @@ def test_check_secondary_counts_random_states(tmp_path):
     assert r.returncode == 2 and "--states must be at most 100" in r.stderr
 
 
+def test_merge_secondary_keeps_per_target_the_set_the_body_confirms_more_often(tmp_path):
+    """scripts/merge_secondary.py: B's set replaces A's for a target only with more
+    confirmations, or as many and fewer falls; a tie or a target B lacks keeps A's. End to
+    end on a one-target pair of files (the walk's own weights named a skip, which no state
+    confirms), the tie keeps A's set, the chosen states are the ones asked for, and the merged
+    file is a secondary results file that check-secondary reads."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "merge_secondary", Path(__file__).parents[1] / "scripts" / "merge_secondary.py")
+    ms = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ms)
+    assert ms.take_b((0, 9), (2, 27)) and ms.take_b((19, 2), (19, 1))
+    assert not ms.take_b((9, 5), (7, 0)) and not ms.take_b((3, 1), (3, 1))
+    assert not ms.take_b((0, 0), None)
+    a = _secondary_file(tmp_path)
+    (tmp_path / "b").mkdir()
+    b = _secondary_file(tmp_path / "b", i_app=0.2)
+    out = tmp_path / "merged.json"
+    assert ms.main([str(a), str(b), "--first", "5330", "--n", "1", "--seconds", "2",
+                    "--workers", "1", "--out", str(out)]) == 0
+    (t,) = json.loads(out.read_text())["targets"]
+    assert t["merged_from"]["file"] == "A" and t["merged_from"]["seeds"] == [5330, 5330]
+    assert t["i_app"] == json.loads(a.read_text())["targets"][0]["i_app"]
+    from cpgbiped.envs.experiments.secondary_check import load_secondary
+
+    assert len(load_secondary(out)) == 1
+
+
 @pytest.mark.parametrize("args,says", [
     (["--physics", "--states", "33"], "--states must be at most 32"),
     (["--states", "3"], "need --physics"),

@@ -84,10 +84,11 @@ MAX_STATES = 100
 
 
 def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None,
-                    states: int = 0) -> dict:
+                    states: int = 0, first: int = CHECK_SEED) -> dict:
     """{"<target> from <source>": {cpg_gait, physical_gait, fell, confirmed, metrics}} from
     the Table 3 state; with ``states`` > 0 also "random_states": {seeds, confirmed, falls,
-    physical_gaits} from that many random initial CPG states (seeds CHECK_SEED and up). With
+    physical_gaits} from that many random initial CPG states (seeds ``first`` and up, by
+    default CHECK_SEED; scripts/merge_secondary.py chooses on others). With
     ``img_dir`` (an existing folder) each Table 3 rollout's chronophotograph is written there
     and the panel of all of them, :func:`montage`."""
     targets = load_secondary(path)
@@ -96,7 +97,7 @@ def check_secondary(path, seconds: float = 20.0, workers: int = 2, img_dir=None,
         key = (t["target"], t["source"])
         seen[key] = seen.get(key, 0) + 1
         t["repeat"] = seen[key] if seen[key] > 1 else 0
-    seeds = list(range(CHECK_SEED, CHECK_SEED + int(states)))
+    seeds = list(range(int(first), int(first) + int(states)))
     jobs = [(t, seconds, None if img_dir is None else str(img_dir), None) for t in targets]
     jobs += [(t, seconds, None, s) for t in targets for s in seeds]
     if workers > 1 and len(jobs) > 1:

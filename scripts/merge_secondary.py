@@ -1,0 +1,89 @@
+"""Merge two `cpgbiped secondary --physics` results per target, chosen by the body on unused
+random CPG states.
+
+    python scripts/merge_secondary.py A.json B.json --first 5330 --n 30 --out MERGED.json
+
+`cpgbiped secondary --physics` keeps, for each target, the candidate weight set that the body
+confirms (both classifiers name the target, no fall) from most of its few selection states;
+two runs of it (other controller gains, another number of selection states) can each hold the
+better set for a different target. For each (target, source) this keeps A's or B's weight set,
+whichever the body confirms from more of the random CPG states [--first, --first + --n)
+(`cpgbiped check-secondary`'s count, envs.experiments.secondary_check); a tie goes to fewer
+falls, then to A. The Table 3 state is never used to choose. Prints each target's counts and
+the sums of A, B and the merge over those states (a rule about replacing a committed file is
+the caller's: README "Secondary gaits in the body"). Writes MERGED.json (format
+"cpgbiped.secondary/1") with A's command, B's command and this one, and per target which file
+it came from and its counts ("merged_from").
+
+Seeds: 3000-3029 are check-secondary's default states, the README's report; choose on states
+no rule has used (scripts/rule_rates.py lists the banks).
+"""
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import sys
+from pathlib import Path
+
+
+def take_b(a: tuple[int, int], b: tuple[int, int] | None) -> bool:
+    """Whether B's weight set replaces A's for one target, from (confirmations, falls) over
+    the same states: more confirmations, then fewer falls; a tie or a target B lacks: A."""
+    return b is not None and (b[0] > a[0] or (b[0] == a[0] and b[1] < a[1]))
+
+
+def main(argv=None) -> int:
+    from cpgbiped.envs.experiments.secondary_check import check_secondary, load_secondary
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("a", help="secondary results file A (ties go to it)")
+    ap.add_argument("b", help="secondary results file B")
+    ap.add_argument("--first", type=int, required=True, help="first random CPG state's seed")
+    ap.add_argument("--n", type=int, default=30, help="number of random CPG states")
+    ap.add_argument("--seconds", type=float, default=20.0)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", required=True, help="the merged file")
+    args = ap.parse_args(argv)
+    files = {"A": Path(args.a), "B": Path(args.b)}
+    raw = {k: json.loads(p.read_text()) for k, p in files.items()}
+    for k, p in files.items():
+        load_secondary(p)  # checked before any rollout
+    counts = {}
+    for k, p in files.items():
+        res = check_secondary(p, args.seconds, args.workers, states=args.n, first=args.first)
+        counts[k] = {(r["source"], name.split(" from ")[0]): (r["random_states"]["confirmed"],
+                                                               r["random_states"]["falls"])
+                     for name, r in res.items()}
+    merged = copy.deepcopy(raw["A"])
+    merged["targets"] = []
+    sums = {"A": [0, 0], "B": [0, 0], "merged": [0, 0]}
+    by_b = {(t["source"], t["target"]): t for t in raw["B"]["targets"]}
+    for t in raw["A"]["targets"]:
+        key = (t["source"], t["target"])
+        ca = counts["A"][key]
+        cb = counts["B"].get(key)
+        use_b = take_b(ca, cb)
+        chosen = copy.deepcopy(by_b[key] if use_b else t)
+        c, other = (cb, ca) if use_b else (ca, cb or (0, 0))
+        chosen["merged_from"] = {"file": "B" if use_b else "A", "seeds": [args.first,
+                                 args.first + args.n - 1], "confirmed": c[0], "falls": c[1],
+                                 "other_confirmed": other[0], "other_falls": other[1]}
+        merged["targets"].append(chosen)
+        for k, v in (("A", ca), ("B", cb or (0, 0)), ("merged", c)):
+            sums[k][0] += v[0]
+            sums[k][1] += v[1]
+        print(f"{t['target']:16s} from {t['source']:5s}: A {ca[0]:2d} confirmed, {ca[1]:2d} falls;"
+              f" B {cb[0] if cb else '-':>2} confirmed, {cb[1] if cb else '-':>2} falls"
+              f" -> {'B' if use_b else 'A'}")
+    for k, (c, f) in sums.items():
+        print(f"{k:6s}: {c} confirmed, {f} falls over seeds {args.first}-{args.first + args.n - 1}")
+    merged["command"] = (f"python scripts/merge_secondary.py A B --first {args.first} --n {args.n}"
+                         f" (A: {raw['A'].get('command', '?')}; B: {raw['B'].get('command', '?')})")
+    Path(args.out).write_text(json.dumps(merged, indent=1) + "\n")
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
