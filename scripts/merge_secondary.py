@@ -1,7 +1,8 @@
 """Merge two `cpgbiped secondary --physics` results per target, chosen by the body on unused
 random CPG states.
 
-    python scripts/merge_secondary.py A.json B.json --first 5330 --n 30 --out MERGED.json
+    python scripts/merge_secondary.py A.json B.json --first 5330 --n 30 [--max-extra-falls F]
+                                      --out MERGED.json
 
 `cpgbiped secondary --physics` keeps, for each target, the candidate weight set that the body
 confirms (both classifiers name the target, no fall) from most of its few selection states;
@@ -9,7 +10,8 @@ two runs of it (other controller gains, another number of selection states) can 
 better set for a different target. For each (target, source) this keeps A's or B's weight set,
 whichever the body confirms from more of the random CPG states [--first, --first + --n)
 (`cpgbiped check-secondary`'s count, envs.experiments.secondary_check); a tie goes to fewer
-falls, then to A. The Table 3 state is never used to choose. Prints each target's counts and
+falls, then to A. With --max-extra-falls F, B's set must also fall in no more than F states
+above A's: confirmations bought with falls are refused. The Table 3 state is never used to choose. Prints each target's counts and
 the sums of A, B and the merge over those states (a rule about replacing a committed file is
 the caller's: README "Secondary gaits in the body"). Writes MERGED.json (format
 "cpgbiped.secondary/1") with A's command, B's command and this one, and per target which file
@@ -27,10 +29,15 @@ import sys
 from pathlib import Path
 
 
-def take_b(a: tuple[int, int], b: tuple[int, int] | None) -> bool:
+def take_b(a: tuple[int, int], b: tuple[int, int] | None,
+           max_extra_falls: int | None = None) -> bool:
     """Whether B's weight set replaces A's for one target, from (confirmations, falls) over
-    the same states: more confirmations, then fewer falls; a tie or a target B lacks: A."""
-    return b is not None and (b[0] > a[0] or (b[0] == a[0] and b[1] < a[1]))
+    the same states: more confirmations (with ``max_extra_falls``: and no more than that many
+    falls above A's), or as many and fewer falls; a tie or a target B lacks: A."""
+    if b is None:
+        return False
+    more = b[0] > a[0] and (max_extra_falls is None or b[1] <= a[1] + max_extra_falls)
+    return more or (b[0] == a[0] and b[1] < a[1])
 
 
 def main(argv=None) -> int:
@@ -43,6 +50,9 @@ def main(argv=None) -> int:
     ap.add_argument("--n", type=int, default=30, help="number of random CPG states")
     ap.add_argument("--seconds", type=float, default=20.0)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--max-extra-falls", type=int, default=None,
+                    help="B's set needs more confirmations and at most this many falls above "
+                         "A's (default: no bound on its falls)")
     ap.add_argument("--out", required=True, help="the merged file")
     args = ap.parse_args(argv)
     files = {"A": Path(args.a), "B": Path(args.b)}
@@ -63,7 +73,7 @@ def main(argv=None) -> int:
         key = (t["source"], t["target"])
         ca = counts["A"][key]
         cb = counts["B"].get(key)
-        use_b = take_b(ca, cb)
+        use_b = take_b(ca, cb, args.max_extra_falls)
         chosen = copy.deepcopy(by_b[key] if use_b else t)
         c, other = (cb, ca) if use_b else (ca, cb or (0, 0))
         chosen["merged_from"] = {"file": "B" if use_b else "A", "seeds": [args.first,
@@ -78,7 +88,10 @@ def main(argv=None) -> int:
               f" -> {'B' if use_b else 'A'}")
     for k, (c, f) in sums.items():
         print(f"{k:6s}: {c} confirmed, {f} falls over seeds {args.first}-{args.first + args.n - 1}")
+    bound = ("" if args.max_extra_falls is None
+             else f" --max-extra-falls {args.max_extra_falls}")
     merged["command"] = (f"python scripts/merge_secondary.py A B --first {args.first} --n {args.n}"
+                         f"{bound}"
                          f" (A: {raw['A'].get('command', '?')}; B: {raw['B'].get('command', '?')})")
     Path(args.out).write_text(json.dumps(merged, indent=1) + "\n")
     print(f"wrote {args.out}")

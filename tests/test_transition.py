@@ -452,6 +452,8 @@ def test_merge_secondary_keeps_per_target_the_set_the_body_confirms_more_often(t
     assert ms.take_b((0, 9), (2, 27)) and ms.take_b((19, 2), (19, 1))
     assert not ms.take_b((9, 5), (7, 0)) and not ms.take_b((3, 1), (3, 1))
     assert not ms.take_b((0, 0), None)
+    assert not ms.take_b((0, 9), (2, 27), max_extra_falls=1)  # bought with 18 falls
+    assert ms.take_b((0, 4), (25, 5), max_extra_falls=1) and ms.take_b((19, 2), (21, 0), 1)
     a = _secondary_file(tmp_path)
     (tmp_path / "b").mkdir()
     b = _secondary_file(tmp_path / "b", i_app=0.2)
