@@ -20,14 +20,17 @@ own state and pushes after 6 s, and the tests CPG seeds 10-19):
   impulse survived over the four push phases, forwards plus backwards
   (envs.robustness.push_envelope; the jump's and the hop's envelopes are not scored, their
   rows carry 0); admissible only when
-  the three conditions above hold for every preset and seed.
+  the three conditions above hold for every preset and seed (the Morris-Lecar jump and hop
+  since session 40: the walk and the run alone admitted the thigh angle, which costs the hop).
 The recommended gain is the best-scoring admissible candidate with K > 0 (the open loop's
 score is printed beside it: feedback is recommended only as "the best closed loop", not as
-better than open loop unless the numbers say so). Writes cpg/feedback_gains.json (read by
+better than open loop unless the numbers say so); when no candidate is admissible, the
+smallest gain tried (the Matsuoka walk on the gains of 2026-12-06, which falls open loop in
+one tuning seed). Writes cpg/feedback_gains.json (read by
 cpg.feedback) with every candidate's numbers and this command.
 
     python3 scripts/feedback_choice.py [--seeds 1000,1001,1002,1003] [--push-s 0.2] [--workers 2]
-                                       [--out cpg/feedback_gains.json]     (about 8 minutes)
+                                       [--out cpg/feedback_gains.json]     (about 16 minutes)
 """
 from __future__ import annotations
 
@@ -49,7 +52,7 @@ CANDIDATES = {
 }
 # Presets whose unperturbed closed-loop rollouts decide admissibility; the push envelopes are
 # scored for the alternating ones (SCORED). The Morris-Lecar jump and hop were added in session
-# 39: the angle pathway that scored best on the walk and the run cost the hop, which the rule
+# 40 (measured in a session copy in 39): the angle pathway that scored best on the walk and the run cost the hop, which the rule
 # could not see. The Hopf network's jump falls open loop (at 6.5 s), so "no fall" cannot be asked
 # of its synchronous presets; its and the Matsuoka network's rows are as before.
 PRESETS = {"ml": ("walk", "run", "jump", "hop"), "hopf": ("walk", "run"), "matsuoka": ("walk",)}

@@ -40,8 +40,37 @@ def take_b(a: tuple[int, int], b: tuple[int, int] | None,
     return more or (b[0] == a[0] and b[1] < a[1])
 
 
+TESTS_AND_TUNING = ((10, 19), (1000, 1099))  # the tests' random states; the tuning's
+
+
+def _counts(path, res: dict) -> dict:
+    """{(source, target, k): (confirmations, falls)} in the file's order (k: the k-th set of
+    that pair in the file; check_secondary returns one row per set, in order)."""
+    from cpgbiped.envs.experiments.secondary_check import load_secondary
+
+    targets = load_secondary(path)
+    if len(targets) != len(res):  # check_secondary names a third set of one target like the second
+        raise SystemExit(f"cpgbiped: error: {path}: a target appears more than twice")
+    out, seen = {}, {}
+    for t, r in zip(targets, res.values()):
+        pair = (t["source"], t["target"])
+        seen[pair] = seen.get(pair, 0) + 1
+        out[pair + (seen[pair],)] = (r["random_states"]["confirmed"], r["random_states"]["falls"])
+    return out
+
+
+def _keys(targets: list[dict]) -> list[tuple]:
+    seen, out = {}, []
+    for t in targets:
+        pair = (t["source"], t["target"])
+        seen[pair] = seen.get(pair, 0) + 1
+        out.append(pair + (seen[pair],))
+    return out
+
+
 def main(argv=None) -> int:
-    from cpgbiped.envs.experiments.secondary_check import check_secondary, load_secondary
+    from cpgbiped.envs.experiments.secondary_check import (MAX_STATES, check_secondary,
+                                                           load_secondary)
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("a", help="secondary results file A (ties go to it)")
@@ -55,44 +84,49 @@ def main(argv=None) -> int:
                          "A's (default: no bound on its falls)")
     ap.add_argument("--out", required=True, help="the merged file")
     args = ap.parse_args(argv)
+    last = args.first + args.n - 1
+    if not 1 <= args.n <= MAX_STATES:
+        ap.exit(2, f"cpgbiped: error: --n must be in [1, {MAX_STATES}], got {args.n}\n")
+    for lo, hi in TESTS_AND_TUNING:
+        if args.first <= hi and last >= lo:
+            ap.exit(2, f"cpgbiped: error: seeds {args.first}-{last} overlap the tests' or the "
+                       f"tuning's CPG states ({lo}-{hi})\n")
     files = {"A": Path(args.a), "B": Path(args.b)}
     raw = {k: json.loads(p.read_text()) for k, p in files.items()}
-    for k, p in files.items():
+    for p in files.values():
         load_secondary(p)  # checked before any rollout
-    counts = {}
-    for k, p in files.items():
-        res = check_secondary(p, args.seconds, args.workers, states=args.n, first=args.first)
-        counts[k] = {(r["source"], name.split(" from ")[0]): (r["random_states"]["confirmed"],
-                                                               r["random_states"]["falls"])
-                     for name, r in res.items()}
+    counts = {k: _counts(p, check_secondary(p, args.seconds, args.workers, states=args.n,
+                                            first=args.first))
+              for k, p in files.items()}
+    keys = {k: _keys(raw[k]["targets"]) for k in files}
+    by_b = dict(zip(keys["B"], raw["B"]["targets"]))
     merged = copy.deepcopy(raw["A"])
     merged["targets"] = []
     sums = {"A": [0, 0], "B": [0, 0], "merged": [0, 0]}
-    by_b = {(t["source"], t["target"]): t for t in raw["B"]["targets"]}
-    for t in raw["A"]["targets"]:
-        key = (t["source"], t["target"])
-        ca = counts["A"][key]
+    for key, t in list(zip(keys["A"], raw["A"]["targets"])) + [
+            (k, None) for k in keys["B"] if k not in keys["A"]]:
+        ca = counts["A"].get(key)  # None: a set B alone has
         cb = counts["B"].get(key)
-        use_b = take_b(ca, cb, args.max_extra_falls)
+        use_b = ca is None or take_b(ca, cb, args.max_extra_falls)
         chosen = copy.deepcopy(by_b[key] if use_b else t)
-        c, other = (cb, ca) if use_b else (ca, cb or (0, 0))
-        chosen["merged_from"] = {"file": "B" if use_b else "A", "seeds": [args.first,
-                                 args.first + args.n - 1], "confirmed": c[0], "falls": c[1],
-                                 "other_confirmed": other[0], "other_falls": other[1]}
+        c, other = (cb, ca) if use_b else (ca, cb)
+        chosen["merged_from"] = {"file": str(files["B" if use_b else "A"]),
+                                 "seeds": [args.first, last], "confirmed": c[0], "falls": c[1],
+                                 "other_confirmed": None if other is None else other[0],
+                                 "other_falls": None if other is None else other[1]}
         merged["targets"].append(chosen)
-        for k, v in (("A", ca), ("B", cb or (0, 0)), ("merged", c)):
-            sums[k][0] += v[0]
-            sums[k][1] += v[1]
-        print(f"{t['target']:16s} from {t['source']:5s}: A {ca[0]:2d} confirmed, {ca[1]:2d} falls;"
-              f" B {cb[0] if cb else '-':>2} confirmed, {cb[1] if cb else '-':>2} falls"
-              f" -> {'B' if use_b else 'A'}")
+        for k, v in (("A", ca), ("B", cb), ("merged", c)):
+            if v is not None:
+                sums[k][0] += v[0]
+                sums[k][1] += v[1]
+        fmt = (lambda v: "  -" if v is None else f"{v[0]:3d} confirmed, {v[1]:2d} falls")
+        print(f"{key[1]:16s} from {key[0]:5s}: A {fmt(ca)}; B {fmt(cb)} -> {'B' if use_b else 'A'}")
     for k, (c, f) in sums.items():
-        print(f"{k:6s}: {c} confirmed, {f} falls over seeds {args.first}-{args.first + args.n - 1}")
-    bound = ("" if args.max_extra_falls is None
-             else f" --max-extra-falls {args.max_extra_falls}")
-    merged["command"] = (f"python scripts/merge_secondary.py A B --first {args.first} --n {args.n}"
-                         f"{bound}"
-                         f" (A: {raw['A'].get('command', '?')}; B: {raw['B'].get('command', '?')})")
+        print(f"{k:6s}: {c} confirmed, {f} falls over seeds {args.first}-{last}")
+    bound = "" if args.max_extra_falls is None else f" --max-extra-falls {args.max_extra_falls}"
+    merged["command"] = (f"python scripts/merge_secondary.py {args.a} {args.b} --first "
+                         f"{args.first} --n {args.n}{bound} (A: {raw['A'].get('command', '?')};"
+                         f" B: {raw['B'].get('command', '?')})")
     Path(args.out).write_text(json.dumps(merged, indent=1) + "\n")
     print(f"wrote {args.out}")
     return 0

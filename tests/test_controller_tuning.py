@@ -308,8 +308,9 @@ def test_a_transition_condition_is_the_transition_command_s_rollout_judged_as_th
     T = build("ml", "run").period_s()
     assert s["judge"] == {"gait": "run", "from_s": pytest.approx(7.0 + 4 * T), "seconds": 5.0}
     assert s["total_s"] == pytest.approx(7.0 + 4 * T + 5.0)
-    res, *_ = transition("ml", "walk", "run", 7.0, 2.0, s["total_s"], feedback=0.01,
-                         seed=c["cpg_seed"], feedback_form=TUNING_FEEDBACK[0])
+    res, *_ = transition("ml", "walk", "run", 7.0, 2.0, s["total_s"],
+                         feedback=TUNING_FEEDBACK[1], seed=c["cpg_seed"],
+                         feedback_form=TUNING_FEEDBACK[0])
     assert s["fell"] == res["fell"]
     if res["fell"]:
         assert s["survived_s"] == pytest.approx(res["fell_at_s"])

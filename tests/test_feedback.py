@@ -294,8 +294,9 @@ def test_the_jump_survives_the_test_conditions_with_feedback():
 # and blows of the same impulse in one 4 ms control tick (the form of the tuning conditions,
 # and the only form measured until 2026-12-04); re-measured 2026-12-05 after the hop corner's
 # foot placement (scripts/hop_placement.py), which the run's first seconds blend: the run's
-# forward pushes, 5 N s open loop and 2.5 with feedback before it, are now 2.5 and 5 (doubled,
-# by the open loop's loss as much as the feedback's gain).
+# forward pushes, 5 N s open loop and 2.5 with feedback before it, were then 2.5 and 5
+# (doubled, by the open loop's loss as much as the feedback's gain); since session 35 they
+# are 5 N s either way (_ENVELOPE_SHORTFALLS).
 _ENVELOPE_SHORTFALLS = {
     # re-measured 2026-12-06 (session 40) when the recommended feedback became Taga's angle in
     # alternating rhythms at K = 0.03: the run's backward push 10 -> 25 N s with feedback (per
