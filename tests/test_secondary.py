@@ -120,7 +120,9 @@ def test_the_body_chooses_on_states_that_no_test_or_check_uses():
     assert not set(seeds) & set(range(10, 20)) and max(seeds) < CHECK_SEED
 
 
-def test_the_score_prefers_confirmations_then_fewer_falls_then_smaller_errors():
+def test_the_score_prefers_confirmations_net_of_falls_then_fewer_falls_then_smaller_errors():
+    """A fall counts against a confirmation: 2 confirmed with 1 fall (net 1) ranks below 1
+    confirmed without a fall (net 1, fewer falls), and below 2 confirmed without one."""
     from cpgbiped.envs.search.secondary_physics import score
 
     def rows(confirmed, fell):
@@ -130,7 +132,11 @@ def test_the_score_prefers_confirmations_then_fewer_falls_then_smaller_errors():
     b = score(rows([True, False, False], [False, False, False]), [0.0])  # 1 confirmed
     c = score(rows([True, True, False], [False, False, False]), [9.0])  # 2, no fall
     d = score(rows([True, True, False], [False, False, None]), [1.0])  # no rhythm: no fall
-    assert sorted([a, b, c, d]) == [d, c, a, b]
+    assert sorted([a, b, c, d]) == [d, c, b, a]
+    # of 16 states: 12 confirmed and 4 falls (net 8) against 9 confirmed and no fall (net 9)
+    many = score(rows([True] * 12 + [False] * 4, [False] * 12 + [True] * 4), [0.0])
+    safe = score(rows([True] * 9 + [False] * 7, [False] * 16), [9.0])
+    assert safe < many
 
 
 def test_a_target_without_candidates_keeps_the_plain_search(monkeypatch):
