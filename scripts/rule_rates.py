@@ -28,8 +28,8 @@ Seed banks used so far (do not reuse them for a new rule): 10-19 the tests' rand
 2500-2999, 5000-5099, 5100-5199 and 5250-5419 earlier rules (2800-2899, 2900-2999 and
 5000-5099 in session 38, 5100-5199 in session 39, 5250-5329 in session 40: the gated feedback's
 adoption, 5330-5419: the secondary sets' merges and re-selection); 3000-3099, 4000-4099 and 5200-5249 censuses,
-transitions and secondary checks (5200-5249: the feedback forms, session 39). Unused: 5420
-and up. The tests' and the tuning's
+transitions and secondary checks (5200-5249: the feedback forms, session 39; 5420-5519: the
+walk's start with the gated feedback, session 40). Unused: 5520 and up. The tests' and the tuning's
 states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
 is what it is for then).
 """
@@ -51,7 +51,7 @@ PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
 # (first, last) CPG seeds of the banks earlier rules, censuses and checks used (docstring)
 USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
               (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099), (5100, 5199),
-              (5200, 5249), (5250, 5329), (5330, 5419))
+              (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519))
 
 
 def one(job):
