@@ -43,29 +43,28 @@ def take_b(a: tuple[int, int], b: tuple[int, int] | None,
 TESTS_AND_TUNING = ((10, 19), (1000, 1099))  # the tests' random states; the tuning's
 
 
-def _counts(path, res: dict) -> dict:
-    """{(source, target, k): (confirmations, falls)} in the file's order (k: the k-th set of
-    that pair in the file; check_secondary returns one row per set, in order)."""
-    from cpgbiped.envs.experiments.secondary_check import load_secondary
-
-    targets = load_secondary(path)
-    if len(targets) != len(res):  # check_secondary names a third set of one target like the second
-        raise SystemExit(f"cpgbiped: error: {path}: a target appears more than twice")
-    out, seen = {}, {}
-    for t, r in zip(targets, res.values()):
-        pair = (t["source"], t["target"])
-        seen[pair] = seen.get(pair, 0) + 1
-        out[pair + (seen[pair],)] = (r["random_states"]["confirmed"], r["random_states"]["falls"])
-    return out
-
-
 def _keys(targets: list[dict]) -> list[tuple]:
+    """(source, target, k) of each set in the file's order, k counting the sets of that pair
+    (a file may hold one pair twice)."""
     seen, out = {}, []
     for t in targets:
         pair = (t["source"], t["target"])
         seen[pair] = seen.get(pair, 0) + 1
         out.append(pair + (seen[pair],))
     return out
+
+
+def _counts(path, keys: list[tuple], res: dict) -> dict:
+    """{key: (confirmations, falls)}: check_secondary returns one row per set, in the file's
+    order, keyed by name (a third set of one target would take the second's name)."""
+    if len(keys) != len(res):
+        raise SystemExit(f"cpgbiped: error: {path}: a target appears more than twice")
+    return {k: (r["random_states"]["confirmed"], r["random_states"]["falls"])
+            for k, r in zip(keys, res.values())}
+
+
+def _fmt(v: tuple[int, int] | None) -> str:
+    return "  -" if v is None else f"{v[0]:3d} confirmed, {v[1]:2d} falls"
 
 
 def main(argv=None) -> int:
@@ -95,10 +94,10 @@ def main(argv=None) -> int:
     raw = {k: json.loads(p.read_text()) for k, p in files.items()}
     for p in files.values():
         load_secondary(p)  # checked before any rollout
-    counts = {k: _counts(p, check_secondary(p, args.seconds, args.workers, states=args.n,
-                                            first=args.first))
-              for k, p in files.items()}
     keys = {k: _keys(raw[k]["targets"]) for k in files}
+    counts = {k: _counts(p, keys[k], check_secondary(p, args.seconds, args.workers,
+                                                     states=args.n, first=args.first))
+              for k, p in files.items()}
     by_b = dict(zip(keys["B"], raw["B"]["targets"]))
     merged = copy.deepcopy(raw["A"])
     merged["targets"] = []
@@ -119,8 +118,7 @@ def main(argv=None) -> int:
             if v is not None:
                 sums[k][0] += v[0]
                 sums[k][1] += v[1]
-        fmt = (lambda v: "  -" if v is None else f"{v[0]:3d} confirmed, {v[1]:2d} falls")
-        print(f"{key[1]:16s} from {key[0]:5s}: A {fmt(ca)}; B {fmt(cb)} -> {'B' if use_b else 'A'}")
+        print(f"{key[1]:16s} from {key[0]:5s}: A {_fmt(ca)}; B {_fmt(cb)} -> {'B' if use_b else 'A'}")
     for k, (c, f) in sums.items():
         print(f"{k:6s}: {c} confirmed, {f} falls over seeds {args.first}-{last}")
     bound = "" if args.max_extra_falls is None else f" --max-extra-falls {args.max_extra_falls}"
