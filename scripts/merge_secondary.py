@@ -1,8 +1,8 @@
 """Merge two `cpgbiped secondary --physics` results per target, chosen by the body on unused
 random CPG states.
 
-    python scripts/merge_secondary.py A.json B.json --first 5330 --n 30 [--max-extra-falls F]
-                                      --out MERGED.json
+    python scripts/merge_secondary.py A.json B.json --first 5330 --n 30
+                                      [--by confirmed|net] [--max-extra-falls F] --out MERGED.json
 
 `cpgbiped secondary --physics` keeps, for each target, the candidate weight set that the body
 confirms (both classifiers name the target, no fall) from most of its few selection states;
@@ -10,7 +10,9 @@ two runs of it (other controller gains, another number of selection states) can 
 better set for a different target. For each (target, source) this keeps A's or B's weight set,
 whichever the body confirms from more of the random CPG states [--first, --first + --n)
 (`cpgbiped check-secondary`'s count, envs.experiments.secondary_check); a tie goes to fewer
-falls, then to A. With --max-extra-falls F, B's set must also fall in no more than F states
+falls, then to A. With --by net, the rule `cpgbiped secondary --physics` itself ranks candidates
+by (envs.search.secondary_physics.score): B's set replaces A's when its confirmations net of
+falls are more; a tie goes to fewer falls, then to A. With --max-extra-falls F, B's set must also fall in no more than F states
 above A's: confirmations bought with falls are refused. The Table 3 state is never used to choose. Prints each target's counts and
 the sums of A, B and the merge over those states (a rule about replacing a committed file is
 the caller's: README "Secondary gaits in the body"). Writes MERGED.json (format
@@ -30,12 +32,15 @@ from pathlib import Path
 
 
 def take_b(a: tuple[int, int], b: tuple[int, int] | None,
-           max_extra_falls: int | None = None) -> bool:
+           max_extra_falls: int | None = None, by: str = "confirmed") -> bool:
     """Whether B's weight set replaces A's for one target, from (confirmations, falls) over
-    the same states: more confirmations (with ``max_extra_falls``: and no more than that many
-    falls above A's), or as many and fewer falls; a tie or a target B lacks: A."""
+    the same states. ``by="confirmed"``: more confirmations (with ``max_extra_falls``: and no
+    more than that many falls above A's), or as many and fewer falls. ``by="net"``: more
+    confirmations minus falls, or as many and fewer falls. A tie or a target B lacks: A."""
     if b is None:
         return False
+    if by == "net":
+        return b[0] - b[1] > a[0] - a[1] or (b[0] - b[1] == a[0] - a[1] and b[1] < a[1])
     more = b[0] > a[0] and (max_extra_falls is None or b[1] <= a[1] + max_extra_falls)
     return more or (b[0] == a[0] and b[1] < a[1])
 
@@ -81,9 +86,14 @@ def main(argv=None) -> int:
     ap.add_argument("--max-extra-falls", type=int, default=None,
                     help="B's set needs more confirmations and at most this many falls above "
                          "A's (default: no bound on its falls)")
+    ap.add_argument("--by", choices=("confirmed", "net"), default="confirmed",
+                    help="per target, keep the set with more confirmations (default) or more "
+                         "confirmations net of falls (the product's selection criterion)")
     ap.add_argument("--out", required=True, help="the merged file")
     args = ap.parse_args(argv)
     last = args.first + args.n - 1
+    if args.by == "net" and args.max_extra_falls is not None:
+        ap.exit(2, "cpgbiped: error: --max-extra-falls bounds --by confirmed only\n")
     if not 1 <= args.n <= MAX_STATES:
         ap.exit(2, f"cpgbiped: error: --n must be in [1, {MAX_STATES}], got {args.n}\n")
     for lo, hi in TESTS_AND_TUNING:
@@ -106,7 +116,7 @@ def main(argv=None) -> int:
             (k, None) for k in keys["B"] if k not in keys["A"]]:
         ca = counts["A"].get(key)  # None: a set B alone has
         cb = counts["B"].get(key)
-        use_b = ca is None or take_b(ca, cb, args.max_extra_falls)
+        use_b = ca is None or take_b(ca, cb, args.max_extra_falls, args.by)
         chosen = copy.deepcopy(by_b[key] if use_b else t)
         c, other = (cb, ca) if use_b else (ca, cb)
         chosen["merged_from"] = {"file": str(files["B" if use_b else "A"]),
@@ -122,6 +132,7 @@ def main(argv=None) -> int:
     for k, (c, f) in sums.items():
         print(f"{k:6s}: {c} confirmed, {f} falls over seeds {args.first}-{last}")
     bound = "" if args.max_extra_falls is None else f" --max-extra-falls {args.max_extra_falls}"
+    bound += " --by net" if args.by == "net" else ""
     merged["command"] = (f"python scripts/merge_secondary.py {args.a} {args.b} --first "
                          f"{args.first} --n {args.n}{bound} (A: {raw['A'].get('command', '?')};"
                          f" B: {raw['B'].get('command', '?')})")

@@ -51,7 +51,7 @@ PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
 # (first, last) CPG seeds of the banks earlier rules, censuses and checks used (docstring)
 USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
               (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099), (5100, 5199),
-              (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519))
+              (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519), (5520, 5579))
 
 
 def one(job):
