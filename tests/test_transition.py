@@ -400,6 +400,23 @@ def test_check_secondary_runs_each_weight_set_through_the_body(tmp_path):
     assert {"physical_gait", "fell", "duty_factor", "lr_phase_lag"} <= set(row)
 
 
+def test_check_secondary_table_names_each_set_by_its_source_and_shows_its_speed():
+    """The table says which primary gait each set breaks (the JSON's first key of a target
+    does not) and the body's speed with its sign: a hesitation walk that walks backwards reads
+    as one."""
+    from cpgbiped.envs.experiments.secondary_check import table
+
+    row = {"found_in_network": True, "cpg_gait": "hesitation_walk",
+           "physical_gait": "hesitation_walk", "fell": False, "lr_phase_lag": 0.36,
+           "flight": 0.0, "speed_mps": -0.25, "confirmed": True}
+    text = table({"hesitation_walk": {**row, "source": "jump"},
+                  "hesitation_walk from run": {**row, "source": "run", "confirmed": False}})
+    lines = text.splitlines()
+    assert "speed m/s" in lines[0]
+    assert "hesitation_walk from jump" in lines[2] and "-0.25" in lines[2]
+    assert "CONFIRMED" in lines[2] and "from run from" not in text
+
+
 def test_check_secondary_draws_every_rollout_with_out(tmp_path):
     """--out: the results as JSON and, for each weight set, a chronophotograph of its rollout,
     all of them in one panel (two per row, the widest scaled to the panel's column)."""

@@ -168,18 +168,22 @@ def montage(paths, out, columns: int = 2) -> Path:
 
 
 def table(res: dict) -> str:
+    """One row per weight set, named by its target and the primary gait it breaks (the JSON's
+    key names the source only for a target found twice), with the body's mean forward speed
+    (m/s, > 0 forwards: a confirmed gait may still move backwards)."""
     from cpgbiped.cpg.io import format_table
 
     rows = []
     for name, r in res.items():
         f = lambda x: "-" if x is None or not np.isfinite(x) else f"{x:.2f}"  # noqa: E731
-        rows.append([name, "yes" if r["found_in_network"] else "no", r["cpg_gait"],
+        label = name if " from " in name else f"{name} from {r['source']}"
+        rows.append([label, "yes" if r["found_in_network"] else "no", r["cpg_gait"],
                      r["physical_gait"], "-" if r["fell"] is None else ("yes" if r["fell"] else "no"),
-                     f(r.get("lr_phase_lag")), f(r.get("flight")),
+                     f(r.get("lr_phase_lag")), f(r.get("flight")), f(r.get("speed_mps")),
                      "CONFIRMED" if r["confirmed"] else "-"]
                     + ([f"{r['random_states']['confirmed']}/{len(r['random_states']['seeds'])}"
                         f", {r['random_states']['falls']} falls"] if "random_states" in r else []))
     more = any("random_states" in r for r in res.values())
     return format_table(rows, ["target", "found in network", "cpg", "physical", "fell",
-                               "L-R lag", "flight", "in the body"]
+                               "L-R lag", "flight", "speed m/s", "in the body"]
                         + (["random states: confirmed"] if more else []))
