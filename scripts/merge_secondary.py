@@ -10,10 +10,12 @@ two runs of it (other controller gains, another number of selection states) can 
 better set for a different target. For each (target, source) this keeps A's or B's weight set,
 whichever the body confirms from more of the random CPG states [--first, --first + --n)
 (`cpgbiped check-secondary`'s count, envs.experiments.secondary_check); a tie goes to fewer
-falls, then to A. With --by net, the rule `cpgbiped secondary --physics` itself ranks candidates
-by (envs.search.secondary_physics.score): B's set replaces A's when its confirmations net of
-falls are more; a tie goes to fewer falls, then to A. With --max-extra-falls F, B's set must also fall in no more than F states
-above A's: confirmations bought with falls are refused. The Table 3 state is never used to choose. Prints each target's counts and
+falls, then to A. With --by net, the rule `cpgbiped secondary --physics` itself ranks
+candidates by (envs.search.secondary_physics.score): B's set replaces A's when its
+confirmations net of falls are more; a tie goes to fewer falls, then to A. With
+--max-extra-falls F (--by confirmed only; refused with --by net), B's set must also fall in
+no more than F states above A's: confirmations bought with falls are refused.
+The Table 3 state is never used to choose. Prints each target's counts and
 the sums of A, B and the merge over those states (a rule about replacing a committed file is
 the caller's: README "Secondary gaits in the body"). Writes MERGED.json (format
 "cpgbiped.secondary/1") with A's command, B's command and this one, and per target which file

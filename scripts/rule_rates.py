@@ -29,7 +29,8 @@ Seed banks used so far (do not reuse them for a new rule): 10-19 the tests' rand
 5000-5099 in session 38, 5100-5199 in session 39, 5250-5329 in session 40: the gated feedback's
 adoption, 5330-5419: the secondary sets' merges and re-selection); 3000-3099, 4000-4099 and 5200-5249 censuses,
 transitions and secondary checks (5200-5249: the feedback forms, session 39; 5420-5519: the
-walk's start with the gated feedback, session 40). Unused: 5520 and up. The tests' and the tuning's
+walk's start with the gated feedback, session 40); 5520-5579 the secondary sets' merge by net
+confirmations (session 41). Unused: 5580 and up. The tests' and the tuning's
 states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
 is what it is for then).
 """

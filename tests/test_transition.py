@@ -504,7 +504,8 @@ def test_merge_secondary_keeps_per_target_the_set_the_body_confirms_more_often(t
     assert t["merged_from"]["file"] == str(a) and t["merged_from"]["seeds"] == [5330, 5330]
     assert t["i_app"] == json.loads(a.read_text())["targets"][0]["i_app"]
     assert len(sc.load_secondary(out)) == 1
-    for bad in (["--first", "1090", "--n", "20"], ["--first", "5330", "--n", "0"]):
+    for bad in (["--first", "1090", "--n", "20"], ["--first", "5330", "--n", "0"],
+                ["--first", "5330", "--by", "net", "--max-extra-falls", "1"]):
         with pytest.raises(SystemExit) as e:
             ms.main([str(a), str(b), *bad, "--out", str(tmp_path / "x.json")])
         assert e.value.code == 2
