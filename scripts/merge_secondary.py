@@ -42,7 +42,9 @@ def take_b(a: tuple[int, int], b: tuple[int, int] | None,
     if b is None:
         return False
     if by == "net":
-        return b[0] - b[1] > a[0] - a[1] or (b[0] - b[1] == a[0] - a[1] and b[1] < a[1])
+        from cpgbiped.envs.search.secondary_physics import net_rank
+
+        return net_rank(*b) < net_rank(*a)
     more = b[0] > a[0] and (max_extra_falls is None or b[1] <= a[1] + max_extra_falls)
     return more or (b[0] == a[0] and b[1] < a[1])
 

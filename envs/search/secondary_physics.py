@@ -100,6 +100,13 @@ def _map(fn, jobs, workers: int) -> list:
     return [fn(j) for j in jobs]
 
 
+def net_rank(confirmed: int, falls: int) -> tuple:
+    """The body's part of :func:`score` from counts (smaller is better): the most
+    confirmations net of falls, then the fewest falls (scripts/merge_secondary.py --by net
+    ranks two files' sets by it too)."""
+    return (-(confirmed - falls), falls)
+
+
 def score(rows: list[dict], objectives) -> tuple:
     """Sort key of one candidate (smaller is better): the most confirmations net of falls
     (each fall counts against one confirmation: a set the body confirms in 12 states and
@@ -109,7 +116,7 @@ def score(rows: list[dict], objectives) -> tuple:
     that fall often (README, "Secondary gaits in the body")."""
     confirmed = sum(r["confirmed"] for r in rows)
     falls = sum(r["fell"] is True for r in rows)
-    return (-(confirmed - falls), falls, float(np.sum(objectives)))
+    return net_rank(confirmed, falls) + (float(np.sum(objectives)),)
 
 
 def physics_secondary(primary_weights: dict, rs: RunSettings, settings: SimSettings = SimSettings(),
