@@ -237,11 +237,11 @@ def test_conditions_can_be_picked_by_number():
     assert s.conditions() == every[:8] + every[20:24]
     assert TuneSettings(("walk",), n_conditions=5).conditions() == every[:5]
     assert condition_ids("3,3,1") == (3, 1)
-    for bad in ("0-3", "20-49", "5-2", "a", "1-", ""):
+    for bad in ("0-3", "20-57", "5-2", "a", "1-", ""):
         with pytest.raises(InputError):
             condition_ids(bad)
     with pytest.raises(InputError):
-        TuneSettings(("walk",), n_conditions=1, condition_ids=(49,))
+        TuneSettings(("walk",), n_conditions=1, condition_ids=(57,))
     # 25-28: pushes twice the largest of the conditions before them, as many forwards as
     # backwards, each from a CPG state of its own
     big = [c["push"] for c in every[24:28]]
@@ -280,8 +280,15 @@ def test_conditions_can_be_picked_by_number():
     assert sorted(set(ways)) == [(0.0, 0.0), (0.0, 0.01), (2.0, 0.0), (2.0, 0.01)]
     assert all(ways.count(w) == 2 for w in set(ways))
     assert sorted({c["change"][0] for c in changes}) == [7.0, 7.5]
-    assert all("change" not in c for c in every[:40])
-    assert len({c["cpg_seed"] for c in every}) == len(every) == MAX_CONDITIONS == 48
+    assert all("change" not in c for c in every[:40] + every[48:])
+    # 49-56: the robustness command's held pushes with the feedback on, through a pathway other
+    # than the transitions' (the recommended one when they were added): issue 21's forward
+    # bar, 10 N s (0.5 N s/kg of the 21 kg body), four times; backwards 5 and 15 N s twice each
+    pushed = every[48:56]
+    assert all(c["feedback"] > 0 and c["feedback_form"] != "angle" for c in pushed)
+    assert sorted(c["push"][1] for c in pushed) == [-15.0] * 2 + [-5.0] * 2 + [10.0] * 4
+    assert all(c["push"][2] == 0.2 and 6.0 < c["push"][0] < 7.0 for c in pushed)
+    assert len({c["cpg_seed"] for c in every}) == len(every) == MAX_CONDITIONS == 56
 
 
 def test_a_transition_condition_is_the_transition_command_s_rollout_judged_as_the_partner():

@@ -1363,7 +1363,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--seconds", type=seconds_arg, default=10.0,
                     help="measured seconds per rollout after 2 s of settling (2-60, default 10)")
     sp.add_argument("--conditions", type=conditions_arg, default=(6, ()), metavar="N",
-                    help="tuning conditions per candidate: the first N (1-48, default 6), "
+                    help="tuning conditions per candidate: the first N (1-56, default 6), "
                          "or numbers and ranges such as 1-8,21-24 (21-24: CPG states "
                          "from which the walk network starts in a jump's rhythm; 25-28: "
                          "pushes of 8 N s; 29-32: a floor of friction x0.4; 33-36: x0.6; "
@@ -1372,7 +1372,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "partner in its family (walk <-> run, jump <-> hop) at 7 or 7.5 s, a "
                          "step or a 2 s ramp, open loop or with feedback, judged as the "
                          "partner from 4 of its cycles after the change for 5 s, whatever "
-                         "--seconds)")
+                         "--seconds; 49-56: pushes held 0.2 s with the feedback on, 10 N s "
+                         "forwards and 5 or 15 N s backwards, after 6.3 s)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")

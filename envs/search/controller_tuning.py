@@ -20,7 +20,8 @@ walk driven by another walk network or the loop closed
 (:data:`TUNING_FEEDBACK`); from the seventeenth on, every preset driven by the Hopf network's;
 the twenty-first to fortieth: transient CPG states, bigger pushes, slippery floors and pushes
 of a settled gait; the forty-first to forty-eighth: a transition to the gait's partner in its
-family (walk <-> run, jump <-> hop) in mid-run, judged as the partner (:func:`tuning_conditions`).
+family (walk <-> run, jump <-> hop) in mid-run, judged as the partner; the forty-ninth to
+fifty-sixth: pushes held 0.2 s with the feedback on (:func:`tuning_conditions`).
 The tests and the README report other conditions (the Table 3 state, CPG seeds 10-19, friction x0.5, x0.7, x1.3,
 x2.0, pushes of 5 N s at 6 s): a tuning condition never starts from the Table 3 state or
 from a test seed, so the two sets are disjoint (tested), and the result file lists its
@@ -143,7 +144,7 @@ ALGORITHMS = ("cmaes", "nsga2")
 SEARCHES = ("corners", "shared", "both")
 # The hand-set gains every tuning chain starts from (its provenance says what they are).
 ROOT_GAINS_FILE = Path(__file__).parents[1] / "control" / "gains_root.json"
-MAX_CONDITIONS = 48
+MAX_CONDITIONS = 56
 FIRST_TUNING_SEED = 1000  # CPG seeds of the tuning conditions start here (tests use 10-19)
 # CPG seeds of the conditions 21-24: random initial states from which the Table 2 walk network
 # starts with its extensors in phase (a jump's rhythm) for one to three cycles before they
@@ -182,6 +183,19 @@ TRANSITIONS = tuple((1080 + 4 * j + i, (at, ramp), closed)  # (CPG seed, change,
                     for j, at in enumerate((7.0, 7.5))
                     for i, (ramp, closed) in enumerate(((0.0, False), (0.0, True), (2.0, False),
                                                         (2.0, True))))
+
+# Conditions 49-56: pushes the product reports with feedback on (issue 21's envelope: held 0.2 s,
+# with the Morris-Lecar feedback that was recommended when they were added, Taga's angle in
+# alternating rhythms at K = 0.03, frozen here as TUNING_FEEDBACK is), from CPG seeds 1088-1095,
+# never a test's. Forwards 10 N s (0.5 N s/kg, the issue's bar) at four moments of the stride
+# after 6.3 s; backwards 5 N s (the size a re-search of the run corner once lost at one phase of
+# the stride, session 41) and 15 N s. Every state's network has its own phase at a given time,
+# so the four moments with four states sample the stride's phases, not one phase four times.
+PUSH_FEEDBACK = ("angle_alternating", 0.03)
+FEEDBACK_PUSHES = ((1088, (6.3, 10.0, 0.2)), (1089, (6.45, 10.0, 0.2)),
+                   (1090, (6.6, 10.0, 0.2)), (1091, (6.75, 10.0, 0.2)),
+                   (1092, (6.3, -5.0, 0.2)), (1093, (6.6, -5.0, 0.2)),
+                   (1094, (6.45, -15.0, 0.2)), (1095, (6.75, -15.0, 0.2)))
 
 
 # Other walk networks for the tuning conditions from the ninth on: Morris-Lecar weight sets
@@ -235,7 +249,9 @@ def tuning_conditions(n: int) -> list[dict]:
     thirty-seventh to fortieth push a settled gait, 5 N s held 0.2 s at 12.3 and 12.8 s
     (:data:`SETTLED_PUSHES`), the forty-first to forty-eighth change the network to the
     gait's partner in its family mid-run (``change``: (at s, ramp s), :data:`TRANSITIONS`,
-    judged as the partner); pick them with :attr:`TuneSettings.condition_ids`
+    judged as the partner), the forty-ninth to fifty-sixth push the torso with the feedback on
+    (``feedback_form``: :data:`PUSH_FEEDBACK`, held 0.2 s: 10 N s forwards, 5 and 15 N s
+    backwards, :data:`FEEDBACK_PUSHES`); pick them with :attr:`TuneSettings.condition_ids`
     (``--conditions 1-8,21-24``)."""
     if not 1 <= int(n) <= MAX_CONDITIONS:
         raise InputError(f"tuning conditions must be 1-{MAX_CONDITIONS}, got {n}")
@@ -259,8 +275,11 @@ def tuning_conditions(n: int) -> list[dict]:
     out += [{"cpg_seed": s, "push": p} for s, p in BIG_PUSHES[:max(0, int(n) - 24)]]
     out += [{"cpg_seed": s, "friction_scale": f} for s, f in SLIPPERY[:max(0, int(n) - 28)]]
     out += [{"cpg_seed": s, "push": p} for s, p in SETTLED_PUSHES[:max(0, int(n) - 36)]]
-    return out + [{"cpg_seed": s, "change": c, **({"feedback": k_fb} if closed else {})}
-                  for s, c, closed in TRANSITIONS[:max(0, int(n) - 40)]]
+    out += [{"cpg_seed": s, "change": c, **({"feedback": k_fb} if closed else {})}
+            for s, c, closed in TRANSITIONS[:max(0, int(n) - 40)]]
+    return out + [{"cpg_seed": s, "push": p, "feedback": PUSH_FEEDBACK[1],
+                   "feedback_form": PUSH_FEEDBACK[0]}
+                  for s, p in FEEDBACK_PUSHES[:max(0, int(n) - 48)]]
 
 
 def condition_ids(text: str) -> tuple[int, ...]:
@@ -293,8 +312,8 @@ def condition_trial(gait: str, control: tuple, cond: dict) -> ControlTrial:
                         friction_scale=cond.get("friction_scale", 1.0), push=cond.get("push"),
                         weights=None if w is None else tuple(w),
                         feedback=cond.get("feedback", 0.0), network=cond.get("network", "ml"),
-                        feedback_form=TUNING_FEEDBACK[0] if cond.get("feedback")
-                        and cond.get("network", "ml") == "ml" else None)
+                        feedback_form=cond.get("feedback_form", TUNING_FEEDBACK[0])
+                        if cond.get("feedback") and cond.get("network", "ml") == "ml" else None)
 
 
 def check_gaits(text: str) -> tuple[str, ...]:
