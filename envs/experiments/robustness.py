@@ -34,6 +34,7 @@ import numpy as np
 
 from cpgbiped.cpg.network import Network
 
+from cpgbiped.envs.control.controller import CONTROL, ControlParams
 from cpgbiped.envs.gaits.criteria import SETTLE_S
 from cpgbiped.envs.gaits.gait_metrics import debounce, edges
 from cpgbiped.envs.simulation.rollout import rollout
@@ -61,9 +62,9 @@ class StridePhase:
 
 
 def stride_phase(network: Network, K: float, after_s: float = PUSH_AFTER_S,
-                 form: str | None = None) -> StridePhase | None:
+                 form: str | None = None, params: ControlParams = CONTROL) -> StridePhase | None:
     """Where the unperturbed gait's strides lie (None when it falls or never steps)."""
-    rec = rollout(network, after_s + 6.0, poses=False, feedback=K, feedback_form=form)
+    rec = rollout(network, after_s + 6.0, params, poses=False, feedback=K, feedback_form=form)
     if rec.fell_at is not None or rec.unstable is not None:
         return None
     left = debounce(rec.contact[:, 0], rec.dt)
@@ -78,19 +79,22 @@ def stride_phase(network: Network, K: float, after_s: float = PUSH_AFTER_S,
 
 
 def survives(network: Network, K: float, t_push: float, impulse: float,
-             form: str | None = None, push_s: float = PUSH_S) -> bool:
-    rec = rollout(network, t_push + HOLD_S, push=(t_push, impulse, push_s),
+             form: str | None = None, push_s: float = PUSH_S,
+             params: ControlParams = CONTROL) -> bool:
+    rec = rollout(network, t_push + HOLD_S, params, push=(t_push, impulse, push_s),
                   poses=False, feedback=K, feedback_form=form)
     return rec.fell_at is None and rec.unstable is None
 
 
 def push_envelope(network: Network, K: float, phases=PUSH_PHASES,
                   ladder=IMPULSE_LADDER_NS, after_s: float = PUSH_AFTER_S,
-                  form: str | None = None, push_s: float = PUSH_S) -> dict:
+                  form: str | None = None, push_s: float = PUSH_S,
+                  params: ControlParams = CONTROL) -> dict:
     """{"stride": {...}, "forward": [impulse per phase], "backward": [...]} (N s survived).
     ``after_s``, ``form``: another push window and feedback form (the gain's choice);
-    ``push_s``: how long each push's force is held (s)."""
-    sp = stride_phase(network, K, after_s, form)
+    ``push_s``: how long each push's force is held (s); ``params``: the controller's gains
+    (default the committed file's; a candidate's when a rule compares two)."""
+    sp = stride_phase(network, K, after_s, form, params)
     if sp is None:
         return {"stride": None, "phases": list(phases), "forward": [0.0] * len(phases),
                 "backward": [0.0] * len(phases),
@@ -102,7 +106,7 @@ def push_envelope(network: Network, K: float, phases=PUSH_PHASES,
         for ph in phases:
             best = 0.0
             for imp in ladder:
-                if not survives(network, K, sp.time_at(ph), sign * imp, form, push_s):
+                if not survives(network, K, sp.time_at(ph), sign * imp, form, push_s, params):
                     break
                 best = float(imp)
             row.append(best)
