@@ -226,7 +226,7 @@ def test_the_worst_condition_weighs_as_told():
 
 
 def test_conditions_can_be_picked_by_number():
-    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-48,
+    """--conditions 1-8,21-24: those tuning conditions, in that order; numbers outside 1-56,
     reversed ranges and text are refused."""
     from cpgbiped.envs.search.controller_tuning import condition_ids
 
@@ -282,8 +282,9 @@ def test_conditions_can_be_picked_by_number():
     assert sorted({c["change"][0] for c in changes}) == [7.0, 7.5]
     assert all("change" not in c for c in every[:40] + every[48:])
     # 49-56: the robustness command's held pushes with the feedback on, through a pathway other
-    # than the transitions' (the recommended one when they were added): issue 21's forward
-    # bar, 10 N s (0.5 N s/kg of the 21 kg body), four times; backwards 5 and 15 N s twice each
+    # than the transitions' (the recommended one when they were added): 10 N s forwards (the
+    # ladder's rung below issue 21's 0.5 N s/kg, 10.5 N s), four times; backwards 5 and 15 N s
+    # twice each
     pushed = every[48:56]
     assert all(c["feedback"] > 0 and c["feedback_form"] != "angle" for c in pushed)
     assert sorted(c["push"][1] for c in pushed) == [-15.0] * 2 + [-5.0] * 2 + [10.0] * 4
@@ -579,6 +580,34 @@ def test_the_closed_loop_tuning_conditions_keep_the_loop_the_chain_was_tuned_in(
     run_control_trial(condition_trial("walk", tuple(params_array(CONTROL)), closed[0]), 0.5,
                       settle_s=0.5)
     assert (seen["feedback_form"], seen["feedback"]) == ("angle", 0.01)
+    # The pushes with the feedback on (49-56) keep theirs: Taga's angle in alternating
+    # rhythms at K = 0.03 (the recommendation when they were added), not the one now set.
+    from cpgbiped.envs.search.controller_tuning import PUSH_FEEDBACK
+
+    assert PUSH_FEEDBACK == ("angle_alternating", 0.03)
+    for c in tuning_conditions(MAX_CONDITIONS)[48:56]:
+        t = condition_trial("run", tuple(params_array(CONTROL)), c)
+        assert (t.feedback_form, t.feedback, t.push) == ("angle_alternating", 0.03, c["push"])
+
+
+def test_envelope_census_refuses_bad_input_before_any_rollout(monkeypatch, capsys, tmp_path):
+    """scripts/envelope_census.py: the tests' and the tuning's states, an empty bank, an unknown
+    gait and an unreadable gains file are usage errors (exit 2) before any rollout starts."""
+    ec = _script("envelope_census")
+    monkeypatch.setattr(ec, "envelope", lambda *a: pytest.fail("a rollout ran"))
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    for args, msg in ((["--first", "1090"], "overlap"), (["--first", "15"], "overlap"),
+                      (["--first", "6000", "--n", "0"], "positive"),
+                      (["--first", "6000", "--gaits", "trot"], "--gaits"),
+                      (["--first", "6000", "--baseline", str(bad)], "bad.json")):
+        with pytest.raises(SystemExit) as e:
+            ec.main([str(ROOT_GAINS_FILE)] + args)
+        assert e.value.code == 2, args
+        assert msg in capsys.readouterr().err, args
+    with pytest.raises(SystemExit) as e:
+        ec.main([str(tmp_path / "missing.json"), "--first", "6000"])
+    assert e.value.code == 2
 
 
 def test_conditions_from_the_seventeenth_drive_the_body_by_the_hopf_network():

@@ -880,7 +880,7 @@ def _largest_inputs(tmp_path) -> dict:
                                          str(MAX_TRIALS), "--workers", cores, "--quiet",
                                          "--out", "o2"],
         "most tuning conditions": ["tune", "--gait", "walk,run,jump,hop", "--pop", "4", "--gens",
-                                   # the last conditions push at 12.8 s for 0.2 s and need
+                                   # conditions 39-40 push at 12.8 s for 0.2 s and need
                                    # 1 s after it: 12 s measured after the settling
                                    "1", "--seconds", "12", "--conditions", str(MAX_CONDITIONS),
                                    "--workers", cores, "--quiet", "--out", "o3"],

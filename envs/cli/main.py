@@ -1373,7 +1373,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "step or a 2 s ramp, open loop or with feedback, judged as the "
                          "partner from 4 of its cycles after the change for 5 s, whatever "
                          "--seconds; 49-56: pushes held 0.2 s with the feedback on, 10 N s "
-                         "forwards and 5 or 15 N s backwards, after 6.3 s)")
+                         "forwards and 5 or 15 N s backwards, at 6.3-6.75 s, with --seconds 6 "
+                         "or more)")
     sp.add_argument("--sigma", type=finite_arg, default=0.15,
                     help="initial step in units of each gain's range (CMA-ES; NSGA-II's "
                          "first population's spread; default 0.15)")

@@ -7,8 +7,8 @@ loop), every number from the body, none from the network alone:
   backwards (-): a constant force held for ``PUSH_S`` = 0.2 s, as in SCONE's perturbed-gait
   tutorial (Tutorial 4c: 100 N for 0.2 s on the pelvis, 20 N s on its 75 kg model; the
   issue's "about 0.27 N s/kg"). ``push_s`` sets another duration, down to one control tick
-  (4 ms, ``rollout.PUSH_TICK_S``: a blow of the same impulse, the form of the controller's
-  tuning conditions and of every envelope measured before 2026-12-04;
+  (4 ms, ``rollout.PUSH_TICK_S``: a blow of the same impulse, the form of most of the
+  controller's tuning conditions and of every envelope measured before 2026-12-04;
   ``scripts/feedback_choice.py`` scores with the held pushes since then). The stride's phase comes from the unperturbed rollout
   with the same K: phase 0 is the first left touchdown at or after ``PUSH_AFTER_S`` (simulation
   time, settling included), the stride period the median of its left touchdown intervals. The
@@ -20,9 +20,11 @@ loop), every number from the body, none from the network alone:
   Friction and CPG states: ``SECONDS`` measured after the settling window; survived, and the
   physical gait the contacts name.
 
-These are report conditions: the pushes at 6 s and later, frictions 0.5/0.7/1.3/2.0 and CPG
-seeds 20-27 are disjoint from the tuning conditions of the controller's gains (CPG seeds
-1000+, frictions 0.6/0.8/1.25/1.6, pushes at 4.5 and 5.5 s; :mod:`cpgbiped.envs.search.controller_tuning`) and
+These are report conditions: the pushes from the Table 3 state at 6 s and later, frictions
+0.5/0.7/1.3/2.0 and CPG seeds 20-27 are disjoint from the tuning conditions of the controller's
+gains (CPG seeds 1000+, frictions 0.4/0.6/0.8/1.25/1.6, blows at 4.5-6.8 s, and since
+2026-12-05 and -06 this command's own held pushes at 6.3-6.8 and 12.3-12.8 s, kept apart by
+their CPG states; :mod:`cpgbiped.envs.search.controller_tuning`) and
 of the recommended feedback gains (``scripts/feedback_choice.py``: CPG seeds 1000+, pushes at
 5.5 s).
 """

@@ -187,9 +187,10 @@ TRANSITIONS = tuple((1080 + 4 * j + i, (at, ramp), closed)  # (CPG seed, change,
 # Conditions 49-56: pushes the product reports with feedback on (issue 21's envelope: held 0.2 s,
 # with the Morris-Lecar feedback that was recommended when they were added, Taga's angle in
 # alternating rhythms at K = 0.03, frozen here as TUNING_FEEDBACK is), from CPG seeds 1088-1095,
-# never a test's. Forwards 10 N s (0.5 N s/kg, the issue's bar) at four moments of the stride
-# after 6.3 s; backwards 5 N s (the size a re-search of the run corner once lost at one phase of
-# the stride, session 41) and 15 N s. Every state's network has its own phase at a given time,
+# never a test's. Forwards 10 N s at four moments, 6.3-6.75 s (the impulse ladder's rung just
+# below the issue's 0.5 N s/kg, 10.5 N s on this body);
+# backwards 5 N s (the size a re-search of the run corner once lost at one phase of the stride,
+# session 41) and 15 N s. Every state's network has its own phase at a given time,
 # so the four moments with four states sample the stride's phases, not one phase four times.
 PUSH_FEEDBACK = ("angle_alternating", 0.03)
 FEEDBACK_PUSHES = ((1088, (6.3, 10.0, 0.2)), (1089, (6.45, 10.0, 0.2)),
@@ -233,8 +234,9 @@ def tuning_conditions(n: int) -> list[dict]:
     """The first ``n`` tuning conditions: ``cpg_seed`` (a random initial CPG state), and for
     most of them a floor friction scale or a push (time s, impulse N s) on the torso, struck in
     one 4 ms control tick (the rollout's default form; the pushes the product reports are held
-    0.2 s, :data:`cpgbiped.envs.experiments.robustness.PUSH_S`, a form no tuning condition
-    uses, so the committed chain of tuning runs replays bit for bit). From the
+    0.2 s, :data:`cpgbiped.envs.experiments.robustness.PUSH_S`, a form only conditions 37-40
+    and 49-56 use, (time s, impulse N s, 0.2), so the committed chain of tuning runs, which
+    used none of them, replays bit for bit). From the
     ninth on, half of them drive the walk by another walk network (``weights``:
     {"walk": (w_a, w_b, w_c)}, :data:`TUNING_WALKS`) and half close the loop (``feedback``:
     the gain of :data:`TUNING_FEEDBACK`, through its pathway), so that the
@@ -786,7 +788,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
     head = ["gait", "network", "cpg_seed", "friction_scale", "push", "weights", "feedback", "cost",
             "fell", "physical_gait", "speed_mps", "froude", "duty_left", "duty_right", "flight",
             "apex_height_m", "stride_cv", "ankle_excursion_deg", "fell_at_s_horizon",
-            "to", "change_at_s", "change_ramp_s"]  # a transition (41-48): judged as "to"
+            "to", "change_at_s", "change_ramp_s",  # a transition (41-48): judged as "to"
+            "feedback_form"]  # the closed loop's pathway (empty open loop)
     rows = []
     n_g = len(settings.gaits)
     best_costs = problem.gait_costs(summaries[k])
@@ -803,7 +806,8 @@ def _tune(rd, ckpt, settings, rs, base, provenance, runner, start, command, prog
                          _r(s["flight"]), _r(s["apex_height_m"]), _r(s["stride_cv"]),
                          _r(s["ankle_excursion_deg"]),
                          "" if late[c * n_g + j] is None else late[c * n_g + j],
-                         *((PARTNER[g], *cond["change"]) if "change" in cond else ("", "", ""))])
+                         *((PARTNER[g], *cond["change"]) if "change" in cond else ("", "", "")),
+                         condition_trial(g, (), cond).feedback_form or ""])
     write_csv(rd.path("tune_conditions.csv"), head, rows)
     return {"gains": gains, "entry": entry, "best": summaries[k], "params": tuned}
 
