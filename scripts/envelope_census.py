@@ -15,8 +15,8 @@ Printed per gait, gains and loop: the envelope's minimum over the phases in each
 summed over the states, and the number of states whose minimum reaches issue 21's bar,
 0.5 N s/kg of the body's mass (10.5 N s on the 21 kg body; the impulse ladder's 10 N s falls
 short of it, 12.5 N s reaches it). The two gains files' rollouts run in the same process pool.
-Seed banks: scripts/rule_rates.py lists the used ones; the tests' and the tuning's states are
-refused.
+Seed banks: scripts/rule_rates.py lists the used ones and refuses the tests' and the
+tuning's states (its checks, shared).
 """
 import argparse
 import json
@@ -25,7 +25,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from rule_rates import USED_BANKS  # noqa: E402
+from rule_rates import check_bank, check_gains_files  # noqa: E402
 
 BAR_NS_PER_KG = 0.5  # issue 21's bar
 GAITS = ("walk", "run", "jump", "hop")
@@ -37,20 +37,15 @@ def one(job):
 
 
 def envelope(gait, seed, gains, loop):
+    from cpgbiped.cpg.feedback import CHOICE
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL, read_gains
     from cpgbiped.envs.experiments.robustness import push_envelope
 
     params = read_gains(gains)[0] if gains else CONTROL
-    K, form = (0.0, None) if loop == "open" else recommended_ml()
+    form, K = (None, 0.0) if loop == "open" else CHOICE["ml"]  # the recommended pathway, gain
     env = push_envelope(build("ml", gait, seed=seed), K, form=form, params=params)
     return {"forward": env["forward"], "backward": env["backward"]}
-
-
-def recommended_ml():
-    path = Path(__file__).resolve().parents[1] / "cpg" / "feedback_gains.json"
-    ml = json.loads(path.read_text())["networks"]["ml"]
-    return float(ml["recommended_gain"]), ml["form"]
 
 
 def main(argv=None):
@@ -67,25 +62,14 @@ def main(argv=None):
     if a.n < 1 or a.workers < 1:
         ap.error("--n and --workers must be positive")
     seeds = range(a.first, a.first + a.n)
-    if a.first < 20 or any(1000 <= s <= 1099 for s in seeds):
-        ap.error("the states overlap the tests' (0-19) or the tuning's (1000-1099)")
     gaits = a.gaits.split(",")
     if not gaits or any(g not in GAITS for g in gaits):
         ap.error(f"--gaits must name some of {', '.join(GAITS)}, got {a.gaits!r}")
-    from cpgbiped.cpg.errors import InputError
-    from cpgbiped.envs.control.controller import read_gains
+    check_bank(ap, a.first, a.n)
+    check_gains_files(ap, *(f for f in (a.baseline, a.candidate) if f is not None))
     from cpgbiped.envs.simulation.biped import body_constants
 
-    for gains in (a.baseline, a.candidate):  # both readable before any rollout starts
-        if gains is not None:
-            try:
-                read_gains(gains)
-            except (InputError, OSError) as e:
-                ap.error(f"{gains}: {e}")
     bar_ns = BAR_NS_PER_KG * body_constants()[1]
-    used = [b for b in USED_BANKS if not (a.first + a.n - 1 < b[0] or a.first > b[1])]
-    if used:
-        print(f"note: seeds overlap banks used before: {used}", file=sys.stderr)
     loops = ["feedback"] + (["open"] if a.open_loop else [])
     files = {"baseline": a.baseline, "candidate": a.candidate}
     jobs = [(g, s, f, loop) for g in gaits for loop in loops for s in seeds

@@ -126,6 +126,30 @@ def noise(a, b, n):
     return math.sqrt(n * p * (1 - p) + n * q * (1 - q))
 
 
+def check_bank(ap: argparse.ArgumentParser, first: int, n: int) -> None:
+    """Refuse (a usage error) a seed bank that overlaps the tests' or the tuning's states; note
+    on stderr the banks of :data:`USED_BANKS` it overlaps."""
+    if 10 <= first + n - 1 and first <= 19 or first < 1100 and first + n > 1000:
+        ap.error("the states overlap the tests' (10-19) or the tuning's (1000-1099)")
+    used = [(lo, hi) for lo, hi in USED_BANKS if first <= hi and first + n - 1 >= lo]
+    if used:
+        print("note: CPG seeds " + ", ".join(f"{lo}-{hi}" for lo, hi in used) + " were used by "
+              "an earlier rule or census: fine for re-counting it, not for a new rule",
+              file=sys.stderr)
+
+
+def check_gains_files(ap: argparse.ArgumentParser, *files: str) -> None:
+    """Refuse (a usage error) a gains file that cannot be read, before any rollout starts."""
+    from cpgbiped.cpg.errors import InputError
+    from cpgbiped.envs.control.controller import read_gains
+
+    for gains in files:
+        try:
+            read_gains(gains)
+        except (InputError, OSError) as e:
+            ap.error(f"{gains}: {e}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("candidate", help="the candidate gains file")
@@ -139,23 +163,12 @@ def main() -> None:
     a = ap.parse_args()
     if not (a.n >= a.n_perturbed >= 0 and a.n >= a.n_feedback >= 0 and a.n > 0):
         ap.error("--n must be positive and at least --n-perturbed and --n-feedback")
-    if 10 <= a.first + a.n - 1 and a.first <= 19 or a.first < 1100 and a.first + a.n > 1000:
-        ap.error("the states overlap the tests' (10-19) or the tuning's (1000-1099)")
-    used = [(lo, hi) for lo, hi in USED_BANKS if a.first <= hi and a.first + a.n - 1 >= lo]
-    if used:
-        print("note: CPG seeds " + ", ".join(f"{lo}-{hi}" for lo, hi in used) + " were used by "
-              "an earlier rule or census: fine for re-counting it, not for a new rule",
-              file=sys.stderr)
-    from cpgbiped.cpg.errors import InputError
+    check_bank(ap, a.first, a.n)
     from cpgbiped.cpg.feedback import RECOMMENDED
-    from cpgbiped.envs.control.controller import GAINS_FILE, read_gains
+    from cpgbiped.envs.control.controller import GAINS_FILE
 
     a.baseline = str(a.baseline or GAINS_FILE)
-    for gains in (a.baseline, a.candidate):  # both readable before any rollout starts
-        try:
-            read_gains(gains)
-        except (InputError, OSError) as e:
-            ap.error(f"{gains}: {e}")
+    check_gains_files(ap, a.baseline, a.candidate)
 
     k_fb = RECOMMENDED["ml"]
     rows = {}
