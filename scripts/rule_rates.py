@@ -32,8 +32,9 @@ transitions and secondary checks (5200-5249: the feedback forms, session 39; 542
 walk's start with the gated feedback, session 40); 5520-5579 the secondary sets' merge by net
 confirmations (session 41); 5580-5759 the run corner's margin re-search (rule R5, session 41);
 5760-5779 the push envelopes of the committed gains and of a run corner re-searched with the
-backward pushes (scripts/envelope_census.py, session 42). Unused: 5780 and up. The tests' and the tuning's
-states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
+backward pushes (scripts/envelope_census.py, session 42); 5780-5909 rule G, the graded
+feedback (session 43: the presets 5780-5879, the transitions 5880-5909). Unused: 5910 and up.
+The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
 is what it is for then).
 """
 import argparse
@@ -55,7 +56,7 @@ PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
 USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
               (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099), (5100, 5199),
               (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519), (5520, 5579),
-              (5580, 5759), (5760, 5779))
+              (5580, 5759), (5760, 5779), (5780, 5909))
 
 
 def one(job):
