@@ -34,8 +34,8 @@ confirmations (session 41); 5580-5759 the run corner's margin re-search (rule R5
 5760-5779 the push envelopes of the committed gains and of a run corner re-searched with the
 backward pushes (scripts/envelope_census.py, session 42); 5780-5909 rule G, the graded
 feedback (session 43: the presets 5780-5879, the transitions 5880-5909). Unused: 5910 and up.
-The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a note (re-counting that rule
-is what it is for then).
+The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a
+note (re-counting that rule is what it is for then).
 """
 import argparse
 import json
