@@ -203,6 +203,14 @@ def _cli(*args, timeout=300):
     (("matrix", "--network", "spiking", "--feedback"), "invalid choice"),
     (("robustness", "--feedback", "x"), "K >= 0"),
     (("optimize", "--gait", "walk", "--feedback", "0.1"), "belongs to optimize --physics"),
+    (("validate", "--feedback-form", "angle"), "--feedback-form needs --feedback"),
+    (("validate", "--feedback", "0.03", "--feedback-form", "tegotae"),
+     "unknown --feedback-form 'tegotae'"),
+    (("validate", "--network", "hopf", "--feedback", "--feedback-form", "load"),
+     "the hopf network has one"),
+    (("robustness", "--feedback-form", "angle"), "--feedback-form needs --feedback"),
+    (("transition", "--from", "walk", "--to", "run", "--feedback", "--feedback-form", "x"),
+     "unknown --feedback-form 'x'"),
 ])
 def test_bad_feedback_input_is_one_line_and_exit_2(args, says):
     r = _cli(*args, timeout=60)
@@ -232,6 +240,23 @@ def test_validate_json_reports_the_feedback_signals():
     assert s["feedback_gain"] == RECOMMENDED["ml"]
     assert set(s["feedback_rms"]) == {"LF", "RF", "LE", "RE"}
     assert min(s["feedback_rms"].values()) > 0
+
+
+def test_feedback_form_chooses_the_pathway_the_rollout_uses():
+    """``--feedback-form`` reaches the rollout: at the same K the load and the angle pathways
+    feed the cells different terms (cpg/feedback.py: the foot's load against the thigh's
+    angle), and naming the recommended pathway gives the rollout ``--feedback K`` alone gives."""
+    rms = {}
+    for form in ("load", "angle", CHOICE["ml"][0], None):
+        extra = ("--feedback-form", form) if form else ()
+        r = _cli("validate", "--gait", "walk", "--seconds", "3", "--feedback", "0.03",
+                 *extra, "--json")
+        assert r.returncode == 0, r.stderr
+        s = json.loads(r.stdout)
+        assert (form or "") in s["source"]
+        rms[form] = s["feedback_rms"]
+    assert rms["load"] != rms["angle"]
+    assert rms[CHOICE["ml"][0]] == rms[None]
 
 
 def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fall(tmp_path):

@@ -143,6 +143,38 @@ def feedback_option(sp, note: str = "") -> None:
                     metavar="K", help=FEEDBACK_HELP + note)
 
 
+def feedback_form_option(sp) -> None:
+    """``--feedback-form FORM`` on a subcommand with ``--feedback``: the Morris-Lecar pathway."""
+    from cpgbiped.cpg.feedback import CHOICE, ML_FORMS
+
+    sp.add_argument("--feedback-form", default=None, metavar="FORM",
+                    help="with --feedback, the Morris-Lecar network's pathway: "
+                         + ", ".join(ML_FORMS) + f" (default: the recommended "
+                         f"{CHOICE['ml'][0]}; equations in cpg/feedback.py)")
+
+
+def feedback_form(a, kind: str, K: float) -> str | None:
+    """The pathway of --feedback-form (None: the network's recommended one); one-line errors
+    for an unknown form, a form without feedback and a network without forms to choose."""
+    from cpgbiped.cpg.feedback import ML_FORMS
+
+    form = getattr(a, "feedback_form", None)
+    if form is None:
+        return None
+    if form not in ML_FORMS:
+        raise _input_error(f"unknown --feedback-form {form!r}: use one of {', '.join(ML_FORMS)}")
+    if kind != "ml":
+        raise _input_error(f"--feedback-form chooses among the Morris-Lecar network's pathways; "
+                           f"the {kind} network has one (see cpg/feedback.py)")
+    if not K:
+        raise _input_error("--feedback-form needs --feedback (open loop no pathway is used)")
+    return form
+
+
+def _with_form(label: str, K: float, form: str | None) -> str:
+    return label + (f", feedback K = {K:g}" if K else "") + (f" ({form})" if form else "")
+
+
 def feedback_gain(a, kind: str) -> float:
     """The gain of --feedback [K] for a network of ``kind`` (0 without the option)."""
     from cpgbiped.cpg.feedback import RECOMMENDED, check_gain
@@ -669,6 +701,7 @@ def _validation(a, stop_on_fall=True, settle_s=None):
     net, label = _network(a)
     net.period()  # a network without a rhythm cannot drive the body: one line, before any work
     K = feedback_gain(a, net.kind)
+    form = feedback_form(a, net.kind, K)
     push, push_s = getattr(a, "push", None), getattr(a, "push_s", None)
     if push is None and push_s is not None:
         raise _input_error("--push-s needs --push T_S IMPULSE_NS (it sets how long that push "
@@ -677,8 +710,8 @@ def _validation(a, stop_on_fall=True, settle_s=None):
                  push=None if push is None else (*push, PUSH_S if push_s is None else push_s),
                  stop_on_fall=stop_on_fall,
                  settle_s=SETTLE_S if settle_s is None else settle_s,
-                 ankle_drive=not a.no_ankle_drive, feedback=K)
-    return v, label + (f", feedback K = {K:g}" if K else "")
+                 ankle_drive=not a.no_ankle_drive, feedback=K, feedback_form=form)
+    return v, _with_form(label, K, form)
 
 
 def _input_error(msg):
@@ -802,8 +835,9 @@ def cmd_robustness(a) -> int:
     net, label = _network(a)
     net.period()
     gains = _gains_to_compare(a, net.kind)
-    res = robustness(net, a.gait, gains, push_s=a.push_s, after_s=a.push_after)
-    res["source"] = label
+    form = feedback_form(a, net.kind, gains[-1])
+    res = robustness(net, a.gait, gains, push_s=a.push_s, after_s=a.push_after, form=form)
+    res["source"] = label + (f", feedback pathway {form}" if form else "")
     stem = os.path.join(a.out, f"robustness_{net.kind}_{net.preset}")
     with io.all_or_nothing():  # the table and its picture land together
         io.write_json(stem + ".json", res)
@@ -858,6 +892,7 @@ def cmd_transition(a) -> int:
                else default_seconds(getattr(a, "from"), a.to, a.at, a.ramp))
     check_transition(a.network, getattr(a, "from"), a.to, a.at, a.ramp, seconds)
     K = feedback_gain(a, a.network)
+    form = feedback_form(a, a.network, K)
     if a.out:
         check_video_size(a.width, a.height, a.fps, seconds)
         out_file(a.out, "--out", ".mp4")
@@ -865,10 +900,10 @@ def cmd_transition(a) -> int:
     out_file(a.rrd, "--rrd", ".rrd")
     src, dst = getattr(a, "from"), a.to
     res, rec, net, to = transition(a.network, src, dst, a.at, a.ramp, seconds, K,
-                                   poses=bool(a.out or a.rrd), seed=a.seed)
-    label = (f"{a.network} {src} -> {dst} at {a.at:g} s" + (f" over {a.ramp:g} s" if a.ramp else "")
-             + (f", CPG seed {a.seed}" if a.seed is not None else "")
-             + (f", feedback K = {K:g}" if K else ""))
+                                   poses=bool(a.out or a.rrd), seed=a.seed, feedback_form=form)
+    label = _with_form(f"{a.network} {src} -> {dst} at {a.at:g} s"
+                       + (f" over {a.ramp:g} s" if a.ramp else "")
+                       + (f", CPG seed {a.seed}" if a.seed is not None else ""), K, form)
     marks = [(a.at, "change")] + ([(a.at + a.ramp, "end of ramp")] if a.ramp else [])
     written = []
     with io.all_or_nothing():  # the video, its gait diagram and the recording land together
@@ -1049,6 +1084,7 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--rrd", required=rrd_required, metavar="FILE.rrd",
                         help="also write a rerun recording")
         feedback_option(sp)
+        feedback_form_option(sp)
 
     def push_args(sp):
         sp.add_argument("--push", type=finite_arg, nargs=2, metavar=("T_S", "IMPULSE_NS"),
@@ -1133,6 +1169,7 @@ def build_parser() -> argparse.ArgumentParser:
         --out/robustness_<network>_<preset>.json and .png (impulse survived against the
         phase of the push).""")
     network_args(sp)
+    feedback_form_option(sp)
     sp.add_argument("--push-s", type=push_seconds_arg, default=PUSH_S, metavar="S",
                     help=f"how long each push's force is held, s (default {PUSH_S:g}, as "
                          f"SCONE's perturbed-gait tutorial; {PUSH_TICK_S:g}: one control tick, "
@@ -1184,6 +1221,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="start --from's network from the random initial CPG state of this "
                          "seed (default: its Table 3 state)")
     feedback_option(sp, " (Morris-Lecar)")
+    feedback_form_option(sp)
     sp.add_argument("--width", type=count_arg(1), default=640)
     sp.add_argument("--height", type=count_arg(1), default=480)
     sp.add_argument("--fps", type=positive_arg, default=30.0)

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cpgbiped.cpg.feedback import CHOICE
 from cpgbiped.cpg.network import Network
 
 from cpgbiped.envs.control.controller import CONTROL, ControlParams
@@ -116,18 +117,21 @@ def push_envelope(network: Network, K: float, phases=PUSH_PHASES,
     return out
 
 
-def condition_survival(network: Network, gait: str | None, K: float) -> dict:
-    """Friction scales and random initial CPG states: survived and the physical gait."""
+def condition_survival(network: Network, gait: str | None, K: float,
+                       form: str | None = None) -> dict:
+    """Friction scales and random initial CPG states: survived and the physical gait (``form``:
+    the Morris-Lecar feedback pathway, None the recommended one)."""
     from cpgbiped.envs.gaits.validate import validate
 
     rows = []
     for f in FRICTIONS:
-        s = validate(network, gait, SECONDS, friction_scale=f, feedback=K).summary()
+        s = validate(network, gait, SECONDS, friction_scale=f, feedback=K,
+                     feedback_form=form).summary()
         rows.append({"condition": f"friction x{f:g}", "fell": bool(s["fell"]),
                      "physical_gait": s["physical_gait"], "speed_mps": s["speed_mps"]})
     for seed in RANDOM_SEEDS:
         net = network.with_state(network.random_state(seed))
-        s = validate(net, gait, SECONDS, feedback=K).summary()
+        s = validate(net, gait, SECONDS, feedback=K, feedback_form=form).summary()
         rows.append({"condition": f"CPG seed {seed}", "fell": bool(s["fell"]),
                      "physical_gait": s["physical_gait"], "speed_mps": s["speed_mps"]})
     return {"conditions": rows, "survived": sum(not r["fell"] for r in rows),
@@ -136,10 +140,12 @@ def condition_survival(network: Network, gait: str | None, K: float) -> dict:
 
 
 def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float | None = None,
-               push_s: float = PUSH_S, after_s: float = PUSH_AFTER_S) -> dict:
+               push_s: float = PUSH_S, after_s: float = PUSH_AFTER_S,
+               form: str | None = None) -> dict:
     """The envelope and the condition survival for each feedback gain in ``gains``; each push's
     force held for ``push_s`` seconds, the pushes' stride from the first left touchdown at or
-    after ``after_s`` (s of simulation, settling included)."""
+    after ``after_s`` (s of simulation, settling included); ``form`` the Morris-Lecar feedback
+    pathway of the gains above 0 (None: the recommended one)."""
     if mass_kg is None:
         from cpgbiped.envs.simulation.biped import body_constants
 
@@ -148,14 +154,16 @@ def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float 
            "mass_kg": mass_kg, "hold_s": HOLD_S, "push_s": float(push_s),
            "push_after_s": float(after_s),
            "ladder_ns": list(IMPULSE_LADDER_NS),
+           "feedback_form": form if form is not None else CHOICE.get(network.kind, (None,))[0],
            "by_gain": []}
     for K in gains:
-        env = push_envelope(network, K, push_s=push_s, after_s=after_s)
+        f = form if K else None  # open loop no pathway is used
+        env = push_envelope(network, K, push_s=push_s, after_s=after_s, form=f)
         for name in ("forward", "backward"):
             env[f"{name}_min_ns"] = float(min(env[name]))
             env[f"{name}_min_ns_per_kg"] = float(min(env[name])) / mass_kg
         res["by_gain"].append({"feedback_gain": float(K), "push": env,
-                               **condition_survival(network, gait, K)})
+                               **condition_survival(network, gait, K, f)})
     return res
 
 
