@@ -121,6 +121,9 @@ def test_the_push_duration_bounds_the_parser_restates_are_the_library_s():
 
     assert (main.PUSH_AFTER_S, main.MAX_PUSH_AFTER_S, main.SETTLE_S_CLI) == (
         PUSH_AFTER_S, MAX_PUSH_AFTER_S, SETTLE_S)
+    from cpgbiped.cpg.feedback import ML_FORMS
+
+    assert main.ML_FORMS_CLI == tuple(ML_FORMS)  # --feedback-form's choices
 
 
 def test_a_push_is_its_impulse_spread_over_whole_control_ticks():

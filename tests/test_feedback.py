@@ -203,12 +203,13 @@ def _cli(*args, timeout=300):
     (("matrix", "--network", "spiking", "--feedback"), "invalid choice"),
     (("robustness", "--feedback", "x"), "K >= 0"),
     (("optimize", "--gait", "walk", "--feedback", "0.1"), "belongs to optimize --physics"),
-    (("validate", "--feedback-form", "angle"), "--feedback-form needs --feedback"),
+    (("validate", "--feedback-form", "angle"), "--feedback-form needs a feedback gain K > 0"),
+    (("validate", "--feedback", "0", "--feedback-form", "angle"), "needs a feedback gain K > 0"),
     (("validate", "--feedback", "0.03", "--feedback-form", "tegotae"),
      "unknown --feedback-form 'tegotae'"),
     (("validate", "--network", "hopf", "--feedback", "--feedback-form", "load"),
-     "the hopf network has one"),
-    (("robustness", "--feedback-form", "angle"), "--feedback-form needs --feedback"),
+     "the hopf network has one, tegotae"),
+    (("robustness", "--feedback-form", "angle"), "--feedback-form needs a feedback gain K > 0"),
     (("transition", "--from", "walk", "--to", "run", "--feedback", "--feedback-form", "x"),
      "unknown --feedback-form 'x'"),
 ])
@@ -245,7 +246,10 @@ def test_validate_json_reports_the_feedback_signals():
 def test_feedback_form_chooses_the_pathway_the_rollout_uses():
     """``--feedback-form`` reaches the rollout: at the same K the load and the angle pathways
     feed the cells different terms (cpg/feedback.py: the foot's load against the thigh's
-    angle), and naming the recommended pathway gives the rollout ``--feedback K`` alone gives."""
+    angle), the JSON names the pathway the loop ran, and naming the recommended pathway gives
+    the rollout ``--feedback K`` alone gives."""
+    from cpgbiped.cpg.feedback import ML_FORMS
+
     rms = {}
     for form in ("load", "angle", CHOICE["ml"][0], None):
         extra = ("--feedback-form", form) if form else ()
@@ -253,10 +257,54 @@ def test_feedback_form_chooses_the_pathway_the_rollout_uses():
                  *extra, "--json")
         assert r.returncode == 0, r.stderr
         s = json.loads(r.stdout)
-        assert (form or "") in s["source"]
+        assert s["feedback_form"] == (form or CHOICE["ml"][0])
+        named = [f for f in ML_FORMS if f"({f})" in s["source"]]
+        assert named == ([form] if form else [])
         rms[form] = s["feedback_rms"]
     assert rms["load"] != rms["angle"]
     assert rms[CHOICE["ml"][0]] == rms[None]
+    r = _cli("validate", "--gait", "walk", "--seconds", "1", "--json")  # open loop: no pathway
+    assert json.loads(r.stdout)["feedback_form"] is None
+
+
+def test_robustness_and_transition_pass_the_form_on(monkeypatch):
+    """The commands hand --feedback-form to the library (stubs record what they receive), and
+    ``robustness`` gives the pathway to the gains above 0 only: open loop uses none."""
+    import cpgbiped.envs.experiments.robustness as rb
+    import cpgbiped.envs.experiments.transition as tr
+    from cpgbiped.envs.cli.main import main
+
+    seen = {}
+
+    def stop(name):
+        def f(*args, **kw):
+            seen[name] = kw
+            raise KeyboardInterrupt  # ends the command before any rollout or output
+        return f
+
+    monkeypatch.setattr(rb, "robustness", stop("robustness"))
+    monkeypatch.setattr(tr, "transition", stop("transition"))
+    for args in (["robustness", "--gait", "walk", "--feedback", "--feedback-form", "load"],
+                 ["transition", "--from", "walk", "--to", "run", "--feedback",
+                  "--feedback-form", "load"]):
+        try:
+            main(args)
+        except KeyboardInterrupt:
+            pass
+    assert seen["robustness"]["form"] == "load"
+    assert seen["transition"]["feedback_form"] == "load"
+    monkeypatch.undo()
+
+    forms = []
+    monkeypatch.setattr(rb, "push_envelope", lambda net, K, **kw: forms.append(
+        ("push", K, kw["form"])) or {"forward": [1.0], "backward": [1.0]})
+    monkeypatch.setattr(rb, "condition_survival", lambda net, gait, K, form=None: forms.append(
+        ("conditions", K, form)) or {})
+    res = rb.robustness(build("ml", "walk"), "walk", [0.0, 0.03], form="load")
+    assert forms == [("push", 0.0, None), ("conditions", 0.0, None), ("push", 0.03, "load"),
+                     ("conditions", 0.03, "load")]
+    assert res["feedback_form"] == "load"
+    assert rb.robustness(build("ml", "walk"), "walk", [0.0])["feedback_form"] is None
 
 
 def test_robustness_envelope_is_the_largest_impulse_survived_before_the_first_fall(tmp_path):

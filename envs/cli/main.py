@@ -86,6 +86,9 @@ PUSH_TICK_S, MAX_PUSH_S, PUSH_S = 0.004, 1.0, 0.2
 # robustness's push window (envs.experiments.robustness.PUSH_AFTER_S, MAX_PUSH_AFTER_S and
 # envs.gaits.criteria.SETTLE_S, restated likewise; checked in the same test)
 PUSH_AFTER_S, MAX_PUSH_AFTER_S, SETTLE_S_CLI = 6.0, 120.0, 2.0
+# The Morris-Lecar feedback pathways (cpg.feedback.ML_FORMS, restated so that parsing needs
+# neither numba nor the feedback choice file; checked in the same test)
+ML_FORMS_CLI = ("load", "load_antagonist", "angle", "reset", "angle_alternating")
 
 
 def push_after_arg(text: str) -> float:
@@ -145,29 +148,29 @@ def feedback_option(sp, note: str = "") -> None:
 
 def feedback_form_option(sp) -> None:
     """``--feedback-form FORM`` on a subcommand with ``--feedback``: the Morris-Lecar pathway."""
-    from cpgbiped.cpg.feedback import CHOICE, ML_FORMS
-
     sp.add_argument("--feedback-form", default=None, metavar="FORM",
                     help="with --feedback, the Morris-Lecar network's pathway: "
-                         + ", ".join(ML_FORMS) + f" (default: the recommended "
-                         f"{CHOICE['ml'][0]}; equations in cpg/feedback.py)")
+                         + ", ".join(ML_FORMS_CLI) + " (default: the recommended one; "
+                         "equations in cpg/feedback.py)")
 
 
 def feedback_form(a, kind: str, K: float) -> str | None:
     """The pathway of --feedback-form (None: the network's recommended one); one-line errors
-    for an unknown form, a form without feedback and a network without forms to choose."""
-    from cpgbiped.cpg.feedback import ML_FORMS
-
+    for a network without pathways to choose, an unknown form and a form without feedback."""
     form = getattr(a, "feedback_form", None)
     if form is None:
         return None
-    if form not in ML_FORMS:
-        raise _input_error(f"unknown --feedback-form {form!r}: use one of {', '.join(ML_FORMS)}")
     if kind != "ml":
+        from cpgbiped.cpg.feedback import CHOICE
+
         raise _input_error(f"--feedback-form chooses among the Morris-Lecar network's pathways; "
-                           f"the {kind} network has one (see cpg/feedback.py)")
+                           f"the {kind} network has one, {CHOICE[kind][0]} (cpg/feedback.py)")
+    if form not in ML_FORMS_CLI:
+        raise _input_error(f"unknown --feedback-form {form!r}: use one of "
+                           f"{', '.join(ML_FORMS_CLI)}")
     if not K:
-        raise _input_error("--feedback-form needs --feedback (open loop no pathway is used)")
+        raise _input_error("--feedback-form needs a feedback gain K > 0 (--feedback [K]); open "
+                           "loop, no pathway is used")
     return form
 
 
@@ -845,7 +848,7 @@ def cmd_robustness(a) -> int:
     if a.json:
         print(io.to_json(res))
     else:
-        print(f"{label}: push envelope (impulse survived, N s, at stride phases from "
+        print(f"{res['source']}: push envelope (impulse survived, N s, at stride phases from "
               f"{res['push_after_s']:g} s; each push held {res['push_s']:g} s), friction "
               f"x0.5/0.7/1.3/2.0 and 8 random CPG states; target {a.gait}")
         print(table(res))

@@ -154,10 +154,12 @@ def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float 
            "mass_kg": mass_kg, "hold_s": HOLD_S, "push_s": float(push_s),
            "push_after_s": float(after_s),
            "ladder_ns": list(IMPULSE_LADDER_NS),
-           "feedback_form": form if form is not None else CHOICE.get(network.kind, (None,))[0],
+           # the pathway of the gains above 0 (None when only open loop was asked)
+           "feedback_form": None if not any(gains) else (
+               form if form is not None else CHOICE.get(network.kind, (None,))[0]),
            "by_gain": []}
     for K in gains:
-        f = form if K else None  # open loop no pathway is used
+        f = form if K else None  # open loop, no pathway is used
         env = push_envelope(network, K, push_s=push_s, after_s=after_s, form=f)
         for name in ("forward", "backward"):
             env[f"{name}_min_ns"] = float(min(env[name]))
@@ -198,7 +200,9 @@ def envelope_picture(res: dict, path) -> None:
     for g, color in zip(res["by_gain"], ("0.3", "tab:red", "tab:blue", "tab:green")):
         p = g["push"]
         ph = np.array(p["phases"])
-        lab = "open loop (K = 0)" if g["feedback_gain"] == 0 else f"feedback K = {g['feedback_gain']:g}"
+        lab = ("open loop (K = 0)" if g["feedback_gain"] == 0 else
+               f"feedback K = {g['feedback_gain']:g}"
+               + (f" ({res['feedback_form']})" if res.get("feedback_form") else ""))
         ax.plot(ph, p["forward"], "o-", color=color, label=lab)
         ax.plot(ph, -np.array(p["backward"]), "s--", color=color)
     ax.axhline(0, color="k", lw=0.6)

@@ -50,6 +50,7 @@ class Validation:
             "ankle_excursion_deg": m.ankle_excursion_deg,
             "physical_gait": m.physical_gait, "cpg_gait": self.cpg_gait,
             "feedback_gain": self.recording.feedback_gain,
+            "feedback_form": self.recording.feedback_form,
             "feedback_rms": _feedback_rms(self.recording, self.settle_s),
         }
         if self.biomech is not None:

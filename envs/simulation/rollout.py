@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.cpg.feedback import check_gain, loop_network
+from cpgbiped.cpg.feedback import CHOICE, check_gain, loop_network
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import Network
 from cpgbiped.models import BIPED_SCENE
@@ -61,6 +61,8 @@ class Recording:
     # ground reaction force on each foot (N, > 0 forwards), the mean over the tick's steps
     grf_z: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (T, 2) vertical
     # ground reaction force on each foot (N, > 0 up), the mean over the tick's steps
+    feedback_form: str | None = None  # the pathway of cpg.feedback the closed loop ran (None:
+    # open loop)
 
 
 def window(rec: Recording, t0: float, t1: float | None = None) -> Recording:
@@ -148,10 +150,12 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
         scale_friction(m, friction_scale)
     d = mujoco.MjData(m)
     dt = m.opt.timestep
+    form = None  # the pathway the closed loop runs (cpg.feedback), recorded
     if K > 0:
         ctrl = CPGController(m, d, None, params,
                              loop=loop_network(network, K, dt * CONTROL_EVERY, seconds,
                                                feedback_form, to, change))
+        form = feedback_form or CHOICE.get(network.kind, (None,))[0]
     else:
         ctrl = CPGController(m, d, cpg_schedule(network, seconds, to=to, change=change), params)
     n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))
@@ -189,7 +193,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
     if not poses:  # the whole loop compiled (envs.step_loop): the same rows, bit for bit
         n, fell, unstable = _compiled_loop(m, d, ctrl, n_ticks, push_tick, push_n, push_force,
                                            torso_id, rec, stop_on_fall)
-        return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path, K)
+        return _recording(rec[:n], dt, fell, unstable, qpos_rec[:0], pose_rec[:0], xml_path, K,
+                          form)
     try:
         # Tick k records row k - 1 (the state after the last steps) and sets the controls of
         # tick k, in one compiled call (kernel.tick); the loop runs one extra tick for the
@@ -223,7 +228,8 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
                 d.xfrc_applied[torso_id, 0] = 0.0
     except mujoco.FatalError as e:
         raise InputError(f"physics became unstable: {e}") from None
-    return _recording(rec[:n], dt, fell, unstable, qpos_rec[:n], pose_rec[:n], xml_path, K)
+    return _recording(rec[:n], dt, fell, unstable, qpos_rec[:n], pose_rec[:n], xml_path, K,
+                      form)
 
 
 COMPILED_CHUNK = 250  # ticks (1 s) between two looks at MuJoCo's warnings
@@ -267,7 +273,7 @@ def _compiled_loop(m, d, ctrl, n_ticks, push_tick, push_n, force, torso_id, rec,
 
 
 def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path,
-               gain: float = 0.0) -> Recording:
+               gain: float = 0.0, form: str | None = None) -> Recording:
     K = kernel
     col = lambda a, n=1: r[:, a:a + n].copy() if n > 1 else r[:, a].copy()  # noqa: E731
     return Recording(col(K.R_T), col(K.R_CONTACT, 2) > 0.5, col(K.R_FORCE, 2), col(K.R_V, 4),
@@ -275,4 +281,4 @@ def _recording(r: np.ndarray, dt: float, fell, unstable, qpos, pose, xml_path,
                      col(K.R_PITCH), col(K.R_COMX), col(K.R_COMZ), col(K.R_MODE, 2),
                      col(K.R_CTRL, 8), col(K.R_POWER, 8), dt * CONTROL_EVERY, dt, fell, unstable,
                      qpos, pose, str(xml_path), col(K.R_FB, 4), gain, col(K.R_GRF_X, 2),
-                     col(K.R_GRF_Z, 2))
+                     col(K.R_GRF_Z, 2), form)
