@@ -155,6 +155,12 @@ CHOICE = _read_choice()
 RECOMMENDED = {k: g for k, (_, g) in CHOICE.items()}
 
 
+def pathway(kind: str, form: str | None = None) -> str:
+    """The name of the pathway a closed loop of a ``kind`` network runs: ``form`` (a Morris-Lecar
+    one of :data:`ML_FORMS`, as :func:`loop_network` takes it) or the network's recommended one."""
+    return form if form is not None else CHOICE[kind][0]
+
+
 def check_gain(kind: str, K) -> float:
     """K as a float in [0, MAX_GAIN[kind]]; a clear error otherwise."""
     try:
@@ -209,7 +215,7 @@ def loop_network(network, K: float, tick_s: float, seconds: float,
     spec = network.loop_spec()
     code, P, act_c, act_w = spec["code"], spec["P"], spec["act_centre"], spec["act_width"]
     if form is None and code == KIND_ML:
-        form = CHOICE["ml"][0]
+        form = pathway("ml")
     if form is not None:
         if code != KIND_ML or form not in ML_FORMS:
             raise InputError(f"feedback forms {', '.join(ML_FORMS)} are the Morris-Lecar "

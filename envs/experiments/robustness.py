@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cpgbiped.cpg.feedback import CHOICE
+from cpgbiped.cpg.feedback import pathway
 from cpgbiped.cpg.network import Network
 
 from cpgbiped.envs.control.controller import CONTROL, ControlParams
@@ -155,8 +155,7 @@ def robustness(network: Network, gait: str | None, gains=(0.0,), mass_kg: float 
            "push_after_s": float(after_s),
            "ladder_ns": list(IMPULSE_LADDER_NS),
            # the pathway of the gains above 0 (None when only open loop was asked)
-           "feedback_form": None if not any(gains) else (
-               form if form is not None else CHOICE.get(network.kind, (None,))[0]),
+           "feedback_form": pathway(network.kind, form) if any(gains) else None,
            "by_gain": []}
     for K in gains:
         f = form if K else None  # open loop, no pathway is used

@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 
 from cpgbiped.cpg.errors import InputError
-from cpgbiped.cpg.feedback import CHOICE, check_gain, loop_network
+from cpgbiped.cpg.feedback import check_gain, loop_network, pathway
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import Network
 from cpgbiped.models import BIPED_SCENE
@@ -155,7 +155,7 @@ def rollout(network: Network, seconds: float, params: ControlParams = CONTROL, *
         ctrl = CPGController(m, d, None, params,
                              loop=loop_network(network, K, dt * CONTROL_EVERY, seconds,
                                                feedback_form, to, change))
-        form = feedback_form or CHOICE.get(network.kind, (None,))[0]
+        form = pathway(network.kind, feedback_form)
     else:
         ctrl = CPGController(m, d, cpg_schedule(network, seconds, to=to, change=change), params)
     n_ticks = int(round(seconds / (dt * CONTROL_EVERY)))
