@@ -541,3 +541,33 @@ def test_toe_up_dorsiflexes_the_swinging_foot_behind_the_hip():
     static = f0 * 0.5 / (k - slope * 0.5)
     assert static == pytest.approx(0.24)
     assert angle[0.5] - angle[0.0] >= 0.5 * static, (angle, static)
+
+
+def test_pitch_tau_s_follows_the_blended_trunk_target_at_its_rate():
+    """pitch_tau_s (the controller's docstring, step 4): the first tick starts the followed
+    trunk pitch target at the blended one; one tick dt later, with the CPG's features moved from
+    the hop's corner (sigma = kappa = 1) to the jump's (sigma = 1, kappa = 0), it has moved
+    1 - exp(-dt / pitch_tau_s) of the way between the two corners' pitch_d (read from the gains,
+    long after the start-up gains have handed over). With pitch_tau_s = 0 it is never set."""
+    from dataclasses import replace
+
+    m, d = lifted_body()
+    a = np.ones((1000, 4))  # every cell bursting: the forced features below stay clipped
+    t0, dt, tau = 100.0, 0.004, 2.0
+    hop = CONTROL.corner("synchronous_coactive").pitch_d
+    jump = CONTROL.corner("synchronous").pitch_d
+    assert abs(hop - jump) > 0.1  # the corners' targets differ (0.45 and 0.20 rad)
+    for p in (replace(CONTROL, pitch_tau_s=tau), replace(CONTROL, pitch_tau_s=0.0)):
+        ctl = CPGController(m, d, synthetic(a), params=p)
+        ctl.S[K.S_C_LR], ctl.S[K.S_V_L], ctl.S[K.S_V_R] = 10.0, 1.0, 1.0  # sigma clipped to 1
+        ctl.S[K.S_C_FE], ctl.S[K.S_V_F], ctl.S[K.S_V_E] = 10.0, 2.0, 2.0  # kappa clipped to 1
+        ctl(t0)
+        first = ctl.S[K.S_PITCH_D]
+        ctl.S[K.S_C_FE] = -10.0  # kappa clipped to 0: the jump's corner
+        ctl(t0 + dt)
+        second = ctl.S[K.S_PITCH_D]
+        if p.pitch_tau_s == 0.0:
+            assert np.isnan(first) and np.isnan(second)
+            continue
+        assert first == pytest.approx(hop, abs=1e-9)
+        assert second == pytest.approx(hop + (1.0 - np.exp(-dt / tau)) * (jump - hop), abs=1e-9)

@@ -28,7 +28,7 @@ from cpgbiped.cpg.feedback import outputs as fb_outputs
 # the shared parameters, then each blended gain's values at the four pattern corners, in
 # CORNER order: (sigma, kappa) = (0, 0), (0, 1), (1, 0), (1, 1).
 SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort", "restart_v",
-          "sync_land")
+          "sync_land", "pitch_tau_s")
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
@@ -37,7 +37,7 @@ BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "k
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
                  "lean_knee": 0.0, "toe_up": 0.0}
-ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0, "sync_land": 0.0}
+ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0, "sync_land": 0.0, "pitch_tau_s": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
 ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up")
@@ -66,7 +66,10 @@ S_AIRBORNE, S_SWING_DONE = 21, 23  # pairs: the swinging foot has left the groun
 # landed; 2: landed and its knee is flexing). Cleared when the knee's flexion stops.
 S_YIELD = 25
 S_SPEED = 27  # the centre of mass's forward speed (m/s), a running average (TAU_FEATURE)
-S_SIZE = 28
+# S_PITCH_D: the trunk's pitch target as followed at the rate pitch_tau_s sets (rad; NaN until
+# the first tick, which starts it at the blended target)
+S_PITCH_D = 28
+S_SIZE = 29
 TAU_FEATURE = 0.5  # s: time constant of those running averages
 # Leg modes (S_MODE), for recordings and tests.
 MODE_SUPPORT, MODE_LIFT, MODE_AIR = 0.0, 1.0, 2.0
@@ -117,6 +120,7 @@ def new_state() -> np.ndarray:
     s[S_C_LR] = 0.5 * FEATURE_PRIOR
     s[S_V_F] = s[S_V_E] = 2.0 * FEATURE_PRIOR
     s[S_C_FE] = FEATURE_PRIOR
+    s[S_PITCH_D] = np.nan
     return s
 
 
@@ -156,6 +160,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     lift_abort = P[5] > 0.5
     restart_v = P[6]  # m/s; 0: off
     sync_land = P[7] > 0.5
+    pitch_tau_s = P[8]  # s; 0: the blended pitch target at once
     # Per leg i (0 left, 1 right): flexor f = a[i], extensor e = a[2 + i].
     e = np.empty(2)
     f = np.empty(2)
@@ -175,6 +180,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         S[S_V_F] += w * (f[0] * f[0] + f[1] * f[1] - S[S_V_F])
         S[S_V_E] += w * (e[0] * e[0] + e[1] * e[1] - S[S_V_E])
         S[S_SPEED] += w * (sens[ix[IX_COMVEL]] - S[S_SPEED])
+    dt_tick_s = t_s - S[S_LAST_T] if S[S_LAST_T] >= 0.0 else 0.0
     S[S_LAST_T] = t_s
     sigma = _clip01(S[S_C_LR] / (math.sqrt(S[S_V_L] * S[S_V_R]) + 1e-3))
     kappa = _clip01(S[S_C_FE] / (math.sqrt(S[S_V_F] * S[S_V_E]) + 1e-3))
@@ -323,6 +329,12 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     # Ankles: the CPG's drive at one gain; a balance reflex adds to it on the ground.
     for c in range(4):
         u[c] = ankle_gain * a[c]
+    if pitch_tau_s > 0.0:  # the trunk's posture follows its blended target at a rate
+        if math.isnan(S[S_PITCH_D]):
+            S[S_PITCH_D] = pitch_d
+        else:
+            S[S_PITCH_D] += (1.0 - math.exp(-dt_tick_s / pitch_tau_s)) * (pitch_d - S[S_PITCH_D])
+        pitch_d = S[S_PITCH_D]
     if lean_knee != 0.0:  # a squat leans the trunk with the knees' flexion
         pitch_d += lean_knee * max(0.0, -0.5 * (knee[0] + knee[1]))
     tau_torso = kp_t * (pitch_d - pitch) - kd_t * pitch_rate

@@ -76,7 +76,12 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    pitch_d' = pitch_d + lean_knee max(0, -(q_knee,L + q_knee,R) / 2) (blended lean_knee, rad
    per rad of the knees' mean flexion, neutral 0: a squat leans the trunk to keep the centre of
    mass over the feet; 0.75 at the hop's corner of the committed gains since session 35, 0 at the
-   others: scripts/hop_squat_search.py);
+   others: scripts/hop_squat_search.py). With ``pitch_tau_s`` > 0 (shared, s; 0 reproduces the
+   controller before it) the blended pitch_d is not taken at once but followed,
+       p_t = p_{t-dt} + (1 - exp(-dt / pitch_tau_s)) (pitch_d - p_{t-dt}),  p_0 = pitch_d,
+   and p_t stands for pitch_d above: the trunk's posture changes at a rate. Its target moves
+   only when the CPG's features move between corners whose pitch_d differ (the start-up, a
+   transition, a rhythm between corners); in a settled gait p_t = pitch_d;
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
    thigh angle in the world as target
        theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
@@ -202,6 +207,8 @@ class ControlParams:
     # while the body is slower than this in an alternating rhythm (0: never; see the docstring)
     sync_land: float  # > 0.5: in a synchronous rhythm a lone foot off the ground, not lifted,
     # extends to land instead of tucking (0 reproduces the controller before it; docstring, 5)
+    pitch_tau_s: float  # s: the trunk's pitch target follows its blended value with this time
+    # constant (0: at once, the controller before it; docstring, 4)
     alternating: Corner  # sigma = 0, kappa = 0 (the walk's rhythm)
     alternating_coactive: Corner  # sigma = 0, kappa = 1 (the run's)
     synchronous: Corner  # sigma = 1, kappa = 0 (the two-legged jump's)

@@ -119,11 +119,13 @@ CORNER_RANGES = dict(
     toe_up=(0.0, 1.0))
 # Gains added after the stages of scripts/tune_gains.sh that search every gain were run: a
 # search takes them only when --only names them, so that those stages reproduce.
-OPT_IN = ("land_yield", "lift_abort", "restart_v", "x_bal", "lean_knee", "toe_up", "sync_land")
+OPT_IN = ("land_yield", "lift_abort", "restart_v", "x_bal", "lean_knee", "toe_up", "sync_land",
+          "pitch_tau_s")
 # ... and of the shared parameters.
 SHARED_RANGES = dict(ankle_gain=(0.05, 0.35), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
                      w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06), lift_abort=(0.0, 1.0),
-                     restart_v=(0.0, 2.0), sync_land=(0.0, 1.0))
+                     restart_v=(0.0, 2.0), sync_land=(0.0, 1.0),
+                     pitch_tau_s=(0.0, 5.0))
 if tuple(CORNER_RANGES) != kernel.BLENDED or tuple(SHARED_RANGES) != kernel.SHARED:
     raise ImportError("the tuning box and envs.control_kernel's parameter layout disagree")
 
