@@ -137,6 +137,10 @@ prev="$OUT/ws/gains.json"
 # tucking by its swing drive; set by hand after a rule on rates over unused CPG states.
 python3 scripts/sync_land.py "$prev" "$OUT"
 prev="$OUT/sl/gains.json"
+# The trunk's posture followed at a rate once the start-up has handed over (journal, session 44):
+# set by hand after rule H' on rates and transitions over unused CPG states.
+python3 scripts/pitch_tau.py "$prev" "$OUT"
+prev="$OUT/pt/gains.json"
 rm -rf "$OUT/final" && cp -r "$(dirname "$prev")" "$OUT/final"
 python3 - "$prev" <<'EOF'
 import sys

@@ -432,18 +432,21 @@ def test_sync_land_acts_only_on_a_lone_foot_and_keeps_stumbling_hops_up():
     seeds 1000-1099; the set is chosen by that fall, not by the outcome with the switch), at
     least three keep hopping to 10 s with it (measured: exactly three, 1049, 1052 and 1060, so
     the margin is zero; 1046, the state the stumble was traced from, falls at 4.9 s with it,
-    earlier than without, and 1094 at 8.5 s)."""
+    earlier than without, and 1094 at 8.5 s). Measured on the gains it was adopted with: the
+    committed ones with pitch_tau_s = 0 (session 44 set it to 1 s, which moves every rollout
+    after the start-up, so that these five states no longer all fall without sync_land)."""
     from dataclasses import replace
 
     from cpgbiped.envs.simulation.rollout import rollout
 
     assert CONTROL.sync_land > 0.5  # the committed gains have it on
+    base = replace(CONTROL, pitch_tau_s=0.0)  # the gains sync_land was adopted with
     kept = 0
     for seed in (1046, 1049, 1052, 1060, 1094):
         net = build("ml", "hop", seed=seed)
-        off = rollout(net, 10.0, replace(CONTROL, sync_land=0.0), poses=False, feedback=0.01,
+        off = rollout(net, 10.0, replace(base, sync_land=0.0), poses=False, feedback=0.01,
                       feedback_form="angle")  # the tuning conditions' loop (TUNING_FEEDBACK)
-        on = rollout(net, 10.0, CONTROL, poses=False, feedback=0.01, feedback_form="angle")
+        on = rollout(net, 10.0, base, poses=False, feedback=0.01, feedback_form="angle")
         assert off.fell_at is not None and 4.9 <= off.fell_at <= 5.6
         n = min(len(off.t), len(on.t))
         k = int(np.argmax(np.any(off.ctrl[:n] != on.ctrl[:n], axis=1)))
@@ -548,16 +551,26 @@ def test_pitch_tau_s_follows_the_blended_trunk_target_at_its_rate():
     trunk pitch target at the blended one; one tick dt later, with the CPG's features moved from
     the hop's corner (sigma = kappa = 1) to the jump's (sigma = 1, kappa = 0), it has moved
     1 - exp(-dt / pitch_tau_s) of the way between the two corners' pitch_d (read from the gains,
-    long after the start-up gains have handed over). With pitch_tau_s = 0 it is never set."""
+    long after the start-up gains have handed over), and at the start, while they hand over
+    (share nu = exp(-t / startup_tau_s)), nu of the rest of the way as well. With pitch_tau_s =
+    0 it is never set."""
     from dataclasses import replace
 
     m, d = lifted_body()
     a = np.ones((1000, 4))  # every cell bursting: the forced features below stay clipped
-    t0, dt, tau = 100.0, 0.004, 2.0
+    dt, tau = 0.004, 2.0
     hop = CONTROL.corner("synchronous_coactive").pitch_d
     jump = CONTROL.corner("synchronous").pitch_d
+    hop0 = CONTROL.startup[3].pitch_d  # the start-up corners at t = 0 (nu = 1)
+    jump0 = CONTROL.startup[2].pitch_d
     assert abs(hop - jump) > 0.1  # the corners' targets differ (0.45 and 0.20 rad)
-    for p in (replace(CONTROL, pitch_tau_s=tau), replace(CONTROL, pitch_tau_s=0.0)):
+    assert CONTROL.startup is not None and CONTROL.startup_tau_s > 0
+    nu = np.exp(-dt / CONTROL.startup_tau_s)
+    filtered0 = hop0 + (1.0 - np.exp(-dt / tau)) * (nu * jump0 + (1 - nu) * jump - hop0)
+    start = nu * (nu * jump0 + (1 - nu) * jump) + (1.0 - nu) * filtered0
+    for p, t0 in ((replace(CONTROL, pitch_tau_s=tau), 100.0),
+                  (replace(CONTROL, pitch_tau_s=tau), 0.0),
+                  (replace(CONTROL, pitch_tau_s=0.0), 100.0)):
         ctl = CPGController(m, d, synthetic(a), params=p)
         ctl.S[K.S_C_LR], ctl.S[K.S_V_L], ctl.S[K.S_V_R] = 10.0, 1.0, 1.0  # sigma clipped to 1
         ctl.S[K.S_C_FE], ctl.S[K.S_V_F], ctl.S[K.S_V_E] = 10.0, 2.0, 2.0  # kappa clipped to 1
@@ -568,6 +581,10 @@ def test_pitch_tau_s_follows_the_blended_trunk_target_at_its_rate():
         second = ctl.S[K.S_PITCH_D]
         if p.pitch_tau_s == 0.0:
             assert np.isnan(first) and np.isnan(second)
+            continue
+        if t0 == 0.0:
+            assert first == pytest.approx(hop0, abs=1e-9)
+            assert second == pytest.approx(start, abs=1e-9)
             continue
         assert first == pytest.approx(hop, abs=1e-9)
         assert second == pytest.approx(hop + (1.0 - np.exp(-dt / tau)) * (jump - hop), abs=1e-9)

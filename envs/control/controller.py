@@ -77,10 +77,13 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    per rad of the knees' mean flexion, neutral 0: a squat leans the trunk to keep the centre of
    mass over the feet; 0.75 at the hop's corner of the committed gains since session 35, 0 at the
    others: scripts/hop_squat_search.py). With ``pitch_tau_s`` > 0 (shared, s; 0 reproduces the
-   controller before it) the blended pitch_d is not taken at once but followed,
-       p_t = p_{t-dt} + (1 - exp(-dt / pitch_tau_s)) (pitch_d - p_{t-dt}),  p_0 = pitch_d,
-   and p_t stands for pitch_d above: the trunk's posture changes at a rate. Its target moves
-   only when the CPG's features move between corners whose pitch_d differ (the start-up, a
+   controller before it; 1 s in the committed gains since session 44, scripts/pitch_tau.py)
+   the blended pitch_d is not taken at once but followed,
+       p_t = nu pitch_d + (1 - nu) [p_{t-dt} + (1 - exp(-dt / pitch_tau_s)) (pitch_d - p_{t-dt})],
+   p_0 = pitch_d, nu = exp(-t / startup_tau_s) the start-up gains' share (0 without them),
+   and p_t stands for pitch_d above: once the start-up gains, which were searched with the
+   target taken at once, have handed over, the trunk's posture changes at a rate. The target
+   moves only when the CPG's features move between corners whose pitch_d differ (a
    transition, a rhythm between corners); in a settled gait p_t = pitch_d;
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
    thigh angle in the world as target
