@@ -10,7 +10,8 @@ that pitches the trunk forwards that fast pushes the feet forwards, the centre o
 behind them, and from tuning CPG seeds 1000-1029 the body fell in 23 of 30 (17 backwards within
 2.5 s of the change). With pitch_tau_s > 0 the target is followed by a first-order filter of
 that time constant once the start-up gains have handed over (the controller's docstring, step
-4); in a settled gait it is the blended target itself.
+4: the gate acts at every tick, so the effective time constant grows from 0.45 s at 8 s to
+1 s); in a settled gait it is the blended target itself.
 
 Chosen on tuning CPG states only (docs/JOURNAL.md, session 44; out/s44): in-family transitions
 at 8 s from seeds 1000-1029 (16 ways x 30), within 4 CPG cycles / falls, committed 121 / 203;
@@ -26,7 +27,7 @@ from pathlib import Path
 from cpgbiped.envs.search.controller_tuning import set_by_hand
 
 TAU_S = 1.0
-RULE = ("rule H' (docs/JOURNAL.md, session 44; fixed at 02:47 on 2026-12-07 before the candidate "
+RULE = ("rule H' (docs/JOURNAL.md, session 44; fixed in commit 09bdc32, 02:46 on 2026-12-07, before the candidate "
         "met any state outside tuning states 1000-1099; baseline the gains before it): H1 the "
         "in-family transitions at 8 s over CPG seeds 6040-6069 (16 ways x 30), within 4 CPG "
         "cycles, above the baseline by more than one sd, falls within noise; H2 over 6070-6169 "

@@ -80,11 +80,16 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    controller before it; 1 s in the committed gains since session 44, scripts/pitch_tau.py)
    the blended pitch_d is not taken at once but followed,
        p_t = nu pitch_d + (1 - nu) [p_{t-dt} + (1 - exp(-dt / pitch_tau_s)) (pitch_d - p_{t-dt})],
-   p_0 = pitch_d, nu = exp(-t / startup_tau_s) the start-up gains' share (0 without them),
-   and p_t stands for pitch_d above: once the start-up gains, which were searched with the
-   target taken at once, have handed over, the trunk's posture changes at a rate. The target
-   moves only when the CPG's features move between corners whose pitch_d differ (a
-   transition, a rhythm between corners); in a settled gait p_t = pitch_d;
+   p_0 = pitch_d, nu = exp(-t / startup_tau_s) the start-up gains' share (0 without them; nu,
+   not restart_v's nu_ac), dt the control tick (4 ms), and p_t stands for pitch_d above: once
+   the start-up gains, which were searched with the target taken at once, have handed over,
+   the trunk's posture changes at a rate. The gate acts on the followed value at every tick,
+   so the gap to the target shrinks by (1 - nu)(1 - dt / pitch_tau_s) per tick: an effective
+   time constant of about dt / (nu + dt / pitch_tau_s), which depends on the tick and grows
+   with t (at pitch_tau_s = 1 s: 0.05 s at 4 s, 0.45 s at 8 s, 0.92 s at 12 s, 1 s late; this
+   is the form rule H' measured, journal "Session 44"). The target moves while the start-up
+   corners hand over to the corners, and when the CPG's features move between corners whose
+   pitch_d differ (a transition, a rhythm between corners); in a settled gait p_t = pitch_d;
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
    thigh angle in the world as target
        theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
