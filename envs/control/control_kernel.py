@@ -199,6 +199,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     # hands over to the first as nu = exp(-t_s / tau_s) (tau_s the last number of P); with
     # restart_v > 0 the alternating co-activated corner's share hands over as nu_ac instead
     # (the controller's docstring).
+    nu = 0.0  # the start-up gains' share (none without them); the pitch filter's gate too
     if P.shape[0] == P_SIZE_STARTUP:
         nu = math.exp(-t_s / P[P_SIZE_STARTUP - 1])
         for n in range(len(BLENDED)):
@@ -334,9 +335,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             S[S_PITCH_D] = pitch_d
         else:
             S[S_PITCH_D] += (1.0 - math.exp(-dt_tick_s / pitch_tau_s)) * (pitch_d - S[S_PITCH_D])
-        if P.shape[0] == P_SIZE_STARTUP:  # ... once the start-up gains have handed over
-            nu_p = math.exp(-t_s / P[P_SIZE_STARTUP - 1])
-            S[S_PITCH_D] = nu_p * pitch_d + (1.0 - nu_p) * S[S_PITCH_D]
+        S[S_PITCH_D] = nu * pitch_d + (1.0 - nu) * S[S_PITCH_D]  # once the start-up has handed over
         pitch_d = S[S_PITCH_D]
     if lean_knee != 0.0:  # a squat leans the trunk with the knees' flexion
         pitch_d += lean_knee * max(0.0, -0.5 * (knee[0] + knee[1]))
