@@ -14,7 +14,7 @@ from cpgbiped.cpg.feedback import RECOMMENDED, loop_network, run_open
 from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import build
 from cpgbiped.envs.simulation.rollout import rollout
-from cpgbiped.envs.experiments.sweep import PERSIST, _first_run, schedule
+from cpgbiped.envs.experiments.sweep import PERSIST, _first_run, cycle_period, schedule
 from cpgbiped.envs.experiments.transition import IN_FAMILY, transition
 
 
@@ -150,6 +150,21 @@ def test_sweep_cli_writes_its_json_and_picture(tmp_path):
     d = [w["drive"] for w in res["windows"]]
     assert min(d) == pytest.approx(0.0, abs=1e-9) and max(d) == pytest.approx(1.0, abs=1e-9)
     assert (tmp_path / "sweep_ml_walk-run.png").stat().st_size > 10_000
+    # The window wholly before the ramp: the network's own cycle is the walk preset's Table 2
+    # period (13.1 model units at the network's time unit), and the body's strides follow it.
+    w0 = res["windows"][0]
+    assert w0["drive"] == 0.0 and w0["start_s"] + 3.0 <= 4.0 + 1e-9
+    walk_period_s = build("ml", "walk").period_s()
+    assert w0["cpg_period_s"] == pytest.approx(walk_period_s, rel=0.03)
+    assert w0["stride_period_s"] == pytest.approx(walk_period_s, rel=0.10)
+    assert w0["stride_length_m"] == pytest.approx(abs(w0["speed_mps"]) * w0["stride_period_s"])
+
+
+def test_cycle_period_counts_upcrossings_of_the_stance_command_inside_the_window():
+    t = np.arange(0.0, 10.0, 0.004)
+    a = 0.5 + 0.5 * np.sin(2 * np.pi * t / 0.8 + 0.3)  # a cell's activation, period 0.8 s
+    assert cycle_period(t, a, 2.0, 6.0) == pytest.approx(0.8, abs=0.005)
+    assert cycle_period(t, a, 2.0, 2.5) is None  # fewer than two upcrossings
 
 
 # -- issue 22's "done when", measured (README "Transitions"); strict xfails --------------------

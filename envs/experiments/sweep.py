@@ -9,6 +9,16 @@ way up from which ``PERSIST`` windows in a row name B; the switch down the first
 way down from which ``PERSIST`` in a row do not (windows in which or after which the body
 fell never count as a switch). Hysteresis: the drive at the switch up minus
 the drive at the switch down (> 0: the gait holds on to B below the drive that brought it).
+
+Each window also carries the body's stride: ``stride_period_s``, the median interval between
+touchdowns of a foot (:mod:`cpgbiped.envs.gaits.gait_metrics`), and ``stride_length_m`` =
+|speed| x stride period; and the network's own cycle, ``cpg_period_s``: the median interval
+between upcrossings of E_ON (the controller's stance command) by the left extensor's
+activation, read from the CPG's signals, never from the body. Speed = stride length / stride
+period, so the picture's middle panel says which of the two a change of speed came from, and
+whether the body's strides follow the network's cycle (README, "Transitions and drive
+sweeps": the Morris-Lecar network's cycle is shortest near d = 0.8, 0.60 s, against the walk's
+1.07 s and the run's 0.72 s).
 """
 from __future__ import annotations
 
@@ -19,7 +29,7 @@ from cpgbiped.cpg.integrate import Schedule
 from cpgbiped.cpg.network import build
 
 from cpgbiped.envs.simulation.rollout import rollout
-from cpgbiped.envs.experiments.transition import window_summary
+from cpgbiped.envs.experiments.transition import E_ON, window_summary
 
 PAIRS = {"walk-run": ("walk", "run"), "jump-hop": ("jump", "hop")}
 START_S, HOLD_S, TAIL_S = 4.0, 4.0, 4.0
@@ -66,7 +76,13 @@ def sweep(pair: str, ramp_s: float = 40.0, kind: str = "ml", feedback: float = 0
         w["drive"] = float(sch.at(tt).mean())
         w["leg"] = "up" if t0 + WINDOW_S / 2 <= t_top else "down"
         v = w["speed_mps"]
-        w["froude"] = float(v * v / (G * leg)) if v is not None and np.isfinite(v) else None
+        ok = v is not None and np.isfinite(v)
+        w["froude"] = float(v * v / (G * leg)) if ok else None
+        T = w.get("stride_period_s")
+        w["stride_period_s"] = float(T) if T is not None and np.isfinite(T) else None
+        w["stride_length_m"] = (float(abs(v) * w["stride_period_s"])
+                                if ok and w["stride_period_s"] is not None else None)
+        w["cpg_period_s"] = cycle_period(rec.t, rec.drive[:, 2], t0, t0 + WINDOW_S)
         windows.append(w)
         t0 += STEP_S
     up = [w for w in windows if w["leg"] == "up"]
@@ -77,12 +93,23 @@ def sweep(pair: str, ramp_s: float = 40.0, kind: str = "ml", feedback: float = 0
            "feedback_gain": rec.feedback_gain, "fell": rec.fell_at is not None,
            "fell_at_s": rec.fell_at, "switch_up": _point(sw_up), "switch_down": _point(sw_down),
            "windows": [{k: w[k] for k in ("start_s", "drive", "leg", "physical_gait",
-                                          "speed_mps", "froude")} for w in windows]}
+                                          "speed_mps", "froude", "stride_period_s",
+                                          "stride_length_m", "cpg_period_s")}
+                       for w in windows]}
     if sw_up is not None and sw_down is not None:
         res["hysteresis_drive"] = sw_up["drive"] - sw_down["drive"]
     else:
         res["hysteresis_drive"] = None
     return res, rec
+
+
+def cycle_period(t_s, activation, t0: float, t1: float) -> float | None:
+    """Median interval (s) between the upcrossings of E_ON by ``activation`` (one cell's, in
+    [0, 1]) inside [t0, t1]; None with fewer than two upcrossings there."""
+    t_s, a = np.asarray(t_s, float), np.asarray(activation, float)
+    up = t_s[1:][(a[1:] >= E_ON) & (a[:-1] < E_ON)]
+    up = up[(up >= t0) & (up <= t1)]
+    return float(np.median(np.diff(up))) if len(up) >= 2 else None
 
 
 def _first_run(ws, pred):
@@ -104,7 +131,8 @@ GAIT_COLORS = {"walk": "tab:green", "run": "tab:red", "jump": "tab:purple", "hop
 
 
 def picture(res: dict, path) -> None:
-    """Speed (top) and physical gait (bottom) against the drive, up and down."""
+    """Speed (top), the body's stride length and stride frequency (middle) and the physical
+    gait (bottom) against the drive, up and down."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -112,25 +140,35 @@ def picture(res: dict, path) -> None:
 
     from cpgbiped.cpg.io import atomic_path
 
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.0), sharex=True,
-                                 gridspec_kw={"height_ratios": [3, 1.4]})
+    fig, (a1, am, a2) = plt.subplots(3, 1, figsize=(6.4, 6.6), sharex=True,
+                                     gridspec_kw={"height_ratios": [3, 1.8, 1.4]})
+    af = am.twinx()
     names = sorted({w["physical_gait"] for w in res["windows"]} | {res["from"], res["to"]})
     for legname, ls, marker, dy in (("up", "-", "^", 0.12), ("down", "--", "v", -0.12)):
         ws = [w for w in res["windows"] if w["leg"] == legname]
         d = [w["drive"] for w in ws]
         a1.plot(d, [w["speed_mps"] for w in ws], ls, color="k", lw=1, label=f"drive {legname}")
+        nan = float("nan")
+        am.plot(d, [nan if w["stride_length_m"] is None else w["stride_length_m"] for w in ws],
+                ls, color="tab:brown", lw=1)
+        af.plot(d, [nan if not w["stride_period_s"] else 1.0 / w["stride_period_s"] for w in ws],
+                ls, color="tab:cyan", lw=1)
+        af.plot(d, [nan if not w["cpg_period_s"] else 1.0 / w["cpg_period_s"] for w in ws],
+                ls, color="tab:blue", lw=0.6, alpha=0.6)
         for w in ws:
             y = names.index(w["physical_gait"]) + dy
             a2.plot(w["drive"], y, marker, color=GAIT_COLORS.get(w["physical_gait"], "0.3"), ms=5)
     for key, color in (("switch_up", "tab:red"), ("switch_down", "tab:blue")):
         p = res[key]
         if p is not None:
-            for ax in (a1, a2):
+            for ax in (a1, am, a2):
                 ax.axvline(p["drive"], color=color, lw=1.2)
             a1.text(p["drive"], a1.get_ylim()[1], f" {key.replace('_', ' ')}\n d={p['drive']:.2f}",
                     color=color, fontsize=8, va="top")
     a2.set_yticks(range(len(names)), names)
     a1.set_ylabel("speed (m/s)")
+    am.set_ylabel("stride (m)", color="tab:brown", fontsize=8)
+    af.set_ylabel("strides / s (CPG cycles / s)", color="tab:cyan", fontsize=8)
     a2.set_xlabel(f"drive d ({res['from']} preset at 0, {res['to']} preset at 1)")
     hy = res["hysteresis_drive"]
     a1.set_title(f"{res['network']} {res['pair']} sweep, ramps of {res['ramp_s']:g} s"

@@ -1,0 +1,79 @@
+"""The body at fixed drives between two presets: what a drive sweep passes through, held.
+
+The network's parameters sit at p_a + d (p_b - p_a) from the start (the sweep's drive d held,
+``cpgbiped sweep`` ramps it), the body is validated for 20 s after settling as ``cpgbiped
+validate`` does, and each drive prints the physical gait, the speed, the body's stride period
+and length, and the network's own cycle (``cpg_period_s`` of the sweep's windows: upcrossings of
+the left extensor's activation through the stance command, read from the CPG's signals):
+
+    python scripts/fixed_drive.py walk run [--drives 0,0.2,...] [--seed S ...] [--feedback K]
+                                  [--set corner.gain=value ...]
+
+--seed: random CPG states (default: the Table 3 state); several seeds print one row each.
+--set: the committed gains with one blended gain changed (e.g. ``alternating.theta0=0.1``,
+``shared.ankle_gain=0.35``): a probe, never written anywhere. Session 45 measured with it why
+the walk slows as the sweep's drive rises (README, "Transitions and drive sweeps").
+"""
+import argparse
+from concurrent.futures import ProcessPoolExecutor
+
+SECONDS = 20.0
+
+
+def one(job):
+    a, b, d, seed, K, sets = job
+    import numpy as np
+
+    from cpgbiped.cpg.integrate import Schedule
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.control.controller import CONTROL, params_from_dict, params_to_dict
+    from cpgbiped.envs.experiments.sweep import cycle_period
+    from cpgbiped.envs.gaits.validate import validate
+
+    g = params_to_dict(CONTROL)
+    for kv in sets:
+        key, value = kv.split("=")
+        part, name = key.rsplit(".", 1)
+        block = g["shared"] if part == "shared" else g["corners"][part]
+        block[name] = float(value)
+    v = validate(build("ml", a, seed=seed), None, SECONDS, to=build("ml", b),
+                 change=Schedule((0.0,), (d,)), params=params_from_dict(g), feedback=K)
+    s, rec = v.summary(), v.recording
+    T_cpg = cycle_period(rec.t, rec.drive[:, 2], s["settle_s"], float(rec.t[-1]))
+    return (d, seed, s["physical_gait"], s["fell_at_s"], s["speed_mps"], s["stride_period_s"],
+            s["stride_length_m"], T_cpg, float(np.mean(list(s["duty_factor"].values()))))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("a")
+    ap.add_argument("b")
+    ap.add_argument("--drives", default="0,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1")
+    ap.add_argument("--seed", type=int, nargs="*", default=[None])
+    ap.add_argument("--feedback", type=float, default=0.0, metavar="K")
+    ap.add_argument("--set", nargs="*", default=[], metavar="CORNER.GAIN=VALUE")
+    args = ap.parse_args()
+    drives = [float(x) for x in args.drives.split(",")]
+    from cpgbiped.envs.control import control_kernel as kernel
+    for kv in args.set:
+        key, _, value = kv.partition("=")
+        part, _, name = key.rpartition(".")
+        known = kernel.SHARED if part == "shared" else kernel.BLENDED if part in kernel.CORNERS else ()
+        if name not in known:
+            ap.error(f"unknown gain {key!r}: shared.NAME or CORNER.NAME, CORNER one of "
+                     f"{', '.join(kernel.CORNERS)}")
+        float(value)
+    jobs = [(args.a, args.b, d, s, args.feedback, args.set) for d in drives for s in args.seed]
+    with ProcessPoolExecutor(2) as ex:
+        rows = list(ex.map(one, jobs))
+    print(f"{args.a} -> {args.b}, fixed drives, {SECONDS:g} s after settling, K = {args.feedback:g}"
+          + (f", {' '.join(args.set)}" if args.set else ""))
+    print("   d  seed  physical  fell   speed m/s  stride s  stride m  CPG cycle s  duty")
+    for d, seed, gait, fell, v, T, L, Tc, duty in rows:
+        f = "-" if fell is None else f"{fell:.1f}"
+        print(f"{d:4.2f}  {str(seed):>4s}  {gait:8s}  {f:>5s}  {v:9.2f}  {T:8.3f}  {L:8.2f}  "
+              f"{'-' if Tc is None else f'{Tc:.3f}':>11s}  {duty:4.2f}")
+
+
+if __name__ == "__main__":
+    main()
