@@ -1,0 +1,87 @@
+"""Where a push leaves the capture point: against the front toe (a forward push) or the rear
+heel (a backward one), state by state, and whether the body falls.
+
+For a body standing on its feet, the instantaneous capture point (Hof, Gazendam & Sinke 2005;
+Pratt et al. 2006) is x_cp = x_com + v_com / omega, omega = sqrt(g / z_com): the point the
+centre of mass would come to rest over if the centre of pressure were put there. The ankles
+can put the centre of pressure anywhere between heel and toe, no further; a push that carries
+x_cp past the front toe cannot be stopped by the ankles alone: the body must step, hop, or
+bend at the hips (and likewise past the rear heel). For each CPG seed of [--first, --first +
+--n) the preset is rolled out from that random state, pushed at --at s (held 0.2 s, as
+``cpgbiped validate --push`` holds it), and the margin is printed at the end of the push, with
+its median and minimum over 4 s before the push while both feet are down: toe - x_cp for a
+forward push, x_cp - heel for a backward one (m, > 0: the capture point inside the feet):
+
+    python scripts/capture_point.py [--gait jump] --first 1000 --n 40 [--impulse 5] [--at 6]
+
+The front toe: the foremost of the two feet's toe sites (models/biped/biped.xml, 0.17 m ahead
+of the ankle and 0.06 m below it, turned with the foot); the rear heel: the hindmost heel site
+(0.07 m behind the ankle). Session 45 measured with it why the
+jump falls after a forward push (journal, "Session 45").
+"""
+import argparse
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+G = 9.81
+TOE = (0.17, -0.06)  # m: the toe site in the foot's frame (x forward, z up)
+HEEL = (-0.07, -0.06)  # m: the heel site
+HELD_S = 0.2
+
+
+def margins(job):
+    gait, seed, impulse, at_s = job
+    import mujoco
+
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    rec = rollout(build("ml", gait, seed=seed), at_s + 6.0, push=(at_s, impulse, HELD_S))
+    m = mujoco.MjModel.from_xml_path(rec.xml_path)
+    edges = []
+    site = TOE if impulse >= 0 else HEEL
+    for side in ("left", "right"):
+        b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, side + "_foot")
+        p, (w, x, y, z) = rec.body_pose[:, b, :3], rec.body_pose[:, b, 3:].T
+        # the x row of the foot's rotation matrix, from its quaternion (w, x, y, z)
+        r00, r02 = 1 - 2 * (y * y + z * z), 2 * (x * z + w * y)
+        edges.append(p[:, 0] + r00 * site[0] + r02 * site[1])
+    t = rec.t
+    v = np.gradient(rec.com_x, t)
+    cp = rec.com_x + v / np.sqrt(G / np.maximum(rec.com_z, 0.3))
+    margin = np.maximum(*edges) - cp if impulse >= 0 else cp - np.minimum(*edges)
+    both = rec.contact.all(axis=1)
+    before = (t > at_s - 4.0) & (t < at_s) & both
+    end = int(np.searchsorted(t, at_s + HELD_S))
+    return (seed, rec.fell_at, float(margin[end]), float(np.median(margin[before])),
+            float(np.min(margin[before])), float(v[end]))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--gait", default="jump")
+    ap.add_argument("--first", type=int, default=1000)
+    ap.add_argument("--n", type=int, default=40)
+    ap.add_argument("--impulse", type=float, default=5.0, help="N s, > 0 forwards")
+    ap.add_argument("--at", type=float, default=6.0, help="s, simulation time")
+    a = ap.parse_args()
+    jobs = [(a.gait, s, a.impulse, a.at) for s in range(a.first, a.first + a.n)]
+    with ProcessPoolExecutor(2) as ex:
+        rows = list(ex.map(margins, jobs))
+    edge = "front toe - capture point" if a.impulse >= 0 else "capture point - rear heel"
+    print(f"{a.gait}, {a.impulse:+g} N s held {HELD_S:g} s at {a.at:g} s; margin = {edge} (m)")
+    print(" seed   fell at   margin at push end   speed m/s   before: median  min")
+    for seed, fell, m_end, m_med, m_min, v in rows:
+        f = "-" if fell is None else f"{fell:.2f}"
+        print(f"{seed:5d}  {f:>8s}   {m_end:18.3f}   {v:9.2f}   {m_med:14.3f}  {m_min:.3f}")
+    edge = "toe" if a.impulse >= 0 else "heel"
+    for lo, hi, what in ((0.01, np.inf, f"more than 1 cm inside the {edge}"),
+                         (-np.inf, 0.01, f"within 1 cm of the {edge} or past it")):
+        sel = [r for r in rows if lo <= r[2] < hi]
+        print(f"capture point {what} at the push's end: {len(sel)} states, "
+              f"{sum(r[1] is not None for r in sel)} fell")
+
+
+if __name__ == "__main__":
+    main()
