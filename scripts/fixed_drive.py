@@ -6,8 +6,8 @@ validate`` does, and each drive prints the physical gait, the speed, the body's 
 and length, and the network's own cycle (``cpg_period_s`` of the sweep's windows: upcrossings of
 the left extensor's activation through the stance command, read from the CPG's signals):
 
-    python scripts/fixed_drive.py walk run [--drives 0,0.2,...] [--seed S ...] [--feedback K]
-                                  [--set corner.gain=value ...]
+    python scripts/fixed_drive.py walk run [--network ml|hopf] [--drives 0,0.2,...] [--seed S ...]
+                                  [--feedback K] [--set corner.gain=value ...]
 
 --seed: random CPG states (default: the Table 3 state); several seeds print one row each.
 --set: the committed gains with one blended gain changed (e.g. ``alternating.theta0=0.1``,
@@ -21,7 +21,7 @@ SECONDS = 20.0
 
 
 def one(job):
-    a, b, d, seed, K, sets = job
+    kind, a, b, d, seed, K, sets = job
     import numpy as np
 
     from cpgbiped.cpg.integrate import Schedule
@@ -36,7 +36,7 @@ def one(job):
         part, name = key.rsplit(".", 1)
         block = g["shared"] if part == "shared" else g["corners"][part]
         block[name] = float(value)
-    v = validate(build("ml", a, seed=seed), None, SECONDS, to=build("ml", b),
+    v = validate(build(kind, a, seed=seed), None, SECONDS, to=build(kind, b),
                  change=Schedule((0.0,), (d,)), params=params_from_dict(g), feedback=K)
     s, rec = v.summary(), v.recording
     T_cpg = cycle_period(rec.t, rec.drive[:, 2], s["settle_s"], float(rec.t[-1]))
@@ -48,6 +48,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("a")
     ap.add_argument("b")
+    ap.add_argument("--network", default="ml", choices=("ml", "hopf"))
     ap.add_argument("--drives", default="0,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1")
     ap.add_argument("--seed", type=int, nargs="*", default=[None])
     ap.add_argument("--feedback", type=float, default=0.0, metavar="K")
@@ -63,10 +64,13 @@ def main() -> None:
             ap.error(f"unknown gain {key!r}: shared.NAME or CORNER.NAME, CORNER one of "
                      f"{', '.join(kernel.CORNERS)}")
         float(value)
-    jobs = [(args.a, args.b, d, s, args.feedback, args.set) for d in drives for s in args.seed]
+    if args.network != "ml" and args.feedback:
+        ap.error("the closed loop through a parameter change is the Morris-Lecar network's")
+    jobs = [(args.network, args.a, args.b, d, s, args.feedback, args.set)
+            for d in drives for s in args.seed]
     with ProcessPoolExecutor(2) as ex:
         rows = list(ex.map(one, jobs))
-    print(f"{args.a} -> {args.b}, fixed drives, {SECONDS:g} s after settling, K = {args.feedback:g}"
+    print(f"{args.network} {args.a} -> {args.b}, fixed drives, {SECONDS:g} s after settling, K = {args.feedback:g}"
           + (f", {' '.join(args.set)}" if args.set else ""))
     print("   d  seed  physical  fell   speed m/s  stride s  stride m  CPG cycle s  duty")
     for d, seed, gait, fell, v, T, L, Tc, duty in rows:
