@@ -8,10 +8,13 @@ the left extensor's activation through the stance command, read from the CPG's s
 
     python scripts/fixed_drive.py walk run [--network ml|hopf] [--drives 0,0.2,...] [--seed S ...]
                                   [--feedback K] [--set corner.gain=value ...]
+                                  [--copy FROM=TO]
 
 --seed: random CPG states (default: the Table 3 state); several seeds print one row each.
---set: the committed gains with one blended gain changed (e.g. ``alternating.theta0=0.1``,
-``shared.ankle_gain=0.35``): a probe, never written anywhere. Session 45 measured with it why
+--set: the committed gains with gains changed (``alternating.theta0=0.1``, a corner's;
+``startup.alternating.theta0=0.1``, a start-up corner's; ``shared.ankle_gain=0.35``): a probe,
+never written anywhere. --copy alternating=alternating_coactive: every gain of corner TO (and of
+its start-up corner) set to corner FROM's, before --set. Session 45 measured with it why
 the walk slows as the sweep's drive rises (README, "Transitions and drive sweeps").
 """
 import argparse
@@ -21,7 +24,7 @@ SECONDS = 20.0
 
 
 def one(job):
-    kind, a, b, d, seed, K, sets = job
+    kind, a, b, d, seed, K, copy, sets = job
     import numpy as np
 
     from cpgbiped.cpg.integrate import Schedule
@@ -31,17 +34,29 @@ def one(job):
     from cpgbiped.envs.gaits.validate import validate
 
     g = params_to_dict(CONTROL)
-    for kv in sets:
-        key, value = kv.split("=")
-        part, name = key.rsplit(".", 1)
-        block = g["shared"] if part == "shared" else g["corners"][part]
-        block[name] = float(value)
+    if copy:
+        src, dst = copy
+        g["corners"][dst] = dict(g["corners"][src])
+        g["startup"]["corners"][dst] = dict(g["startup"]["corners"][src])
+    for key, value in sets:
+        block(g, key)[key.rsplit(".", 1)[1]] = value
     v = validate(build(kind, a, seed=seed), None, SECONDS, to=build(kind, b),
                  change=Schedule((0.0,), (d,)), params=params_from_dict(g), feedback=K)
     s, rec = v.summary(), v.recording
     T_cpg = cycle_period(rec.t, rec.drive[:, 2], s["settle_s"], float(rec.t[-1]))
     return (d, seed, s["physical_gait"], s["fell_at_s"], s["speed_mps"], s["stride_period_s"],
             s["stride_length_m"], T_cpg, float(np.mean(list(s["duty_factor"].values()))))
+
+
+def block(g: dict, key: str) -> dict:
+    """The dict of a gains file (params_to_dict form) that holds ``key``: shared.NAME,
+    CORNER.NAME or startup.CORNER.NAME; KeyError when there is none."""
+    part = key.rsplit(".", 1)[0]
+    if part == "shared":
+        return g["shared"]
+    if part.startswith("startup."):
+        return g["startup"]["corners"][part.split(".", 1)[1]]
+    return g["corners"][part]
 
 
 def main() -> None:
@@ -53,25 +68,49 @@ def main() -> None:
     ap.add_argument("--seed", type=int, nargs="*", default=[None])
     ap.add_argument("--feedback", type=float, default=0.0, metavar="K")
     ap.add_argument("--set", nargs="*", default=[], metavar="CORNER.GAIN=VALUE")
+    ap.add_argument("--copy", default=None, metavar="FROM=TO")
     args = ap.parse_args()
-    drives = [float(x) for x in args.drives.split(",")]
-    from cpgbiped.envs.control import control_kernel as kernel
+    import math
+
+    from cpgbiped.cpg.network import PRESETS
+    from cpgbiped.envs.control.controller import CONTROL, params_to_dict
+
+    for p in (args.a, args.b):
+        if p not in PRESETS[args.network]:
+            ap.error(f"unknown {args.network} preset {p!r}: use {', '.join(PRESETS[args.network])}")
+    try:
+        drives = [float(x) for x in args.drives.split(",")]
+    except ValueError:
+        ap.error(f"--drives: comma-separated numbers, got {args.drives!r}")
+    if not all(0.0 <= d <= 1.0 for d in drives):
+        ap.error(f"--drives must lie in [0, 1], got {args.drives!r}")
+    if not args.seed:
+        ap.error("--seed needs at least one CPG seed (leave it out for the Table 3 state)")
+    g, sets = params_to_dict(CONTROL), []
     for kv in args.set:
         key, _, value = kv.partition("=")
-        part, _, name = key.rpartition(".")
-        known = kernel.SHARED if part == "shared" else kernel.BLENDED if part in kernel.CORNERS else ()
-        if name not in known:
-            ap.error(f"unknown gain {key!r}: shared.NAME or CORNER.NAME, CORNER one of "
-                     f"{', '.join(kernel.CORNERS)}")
-        float(value)
+        try:
+            known = key.rsplit(".", 1)[1] in block(g, key)
+            v = float(value)
+        except (KeyError, IndexError, ValueError):
+            known = False
+        if not known or not math.isfinite(v):
+            ap.error(f"--set {kv!r}: shared.NAME, CORNER.NAME or startup.CORNER.NAME = a number")
+        sets.append((key, v))
+    copy = None
+    if args.copy:
+        copy = tuple(args.copy.split("="))
+        if len(copy) != 2 or any(c not in g["corners"] for c in copy):
+            ap.error(f"--copy FROM=TO, both corners of {', '.join(g['corners'])}")
     if args.network != "ml" and args.feedback:
         ap.error("the closed loop through a parameter change is the Morris-Lecar network's")
-    jobs = [(args.network, args.a, args.b, d, s, args.feedback, args.set)
+    jobs = [(args.network, args.a, args.b, d, s, args.feedback, copy, sets)
             for d in drives for s in args.seed]
     with ProcessPoolExecutor(2) as ex:
         rows = list(ex.map(one, jobs))
     print(f"{args.network} {args.a} -> {args.b}, fixed drives, {SECONDS:g} s after settling, K = {args.feedback:g}"
-          + (f", {' '.join(args.set)}" if args.set else ""))
+          + (f", {' '.join(args.set)}" if args.set else "")
+          + (f", corner {copy[1]} := {copy[0]}" if copy else ""))
     print("   d  seed  physical  fell   speed m/s  stride s  stride m  CPG cycle s  duty")
     for d, seed, gait, fell, v, T, L, Tc, duty in rows:
         f = "-" if fell is None else f"{fell:.1f}"

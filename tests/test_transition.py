@@ -150,8 +150,10 @@ def test_sweep_cli_writes_its_json_and_picture(tmp_path):
     d = [w["drive"] for w in res["windows"]]
     assert min(d) == pytest.approx(0.0, abs=1e-9) and max(d) == pytest.approx(1.0, abs=1e-9)
     assert (tmp_path / "sweep_ml_walk-run.png").stat().st_size > 10_000
-    # The window wholly before the ramp: the network's own cycle is the walk preset's Table 2
-    # period (13.1 model units at the network's time unit), and the body's strides follow it.
+    # The window wholly before the ramp (1-4 s): the network's own cycle, read from its
+    # activations, is the walk preset's Table 2 period (13.1 model units at the network's time
+    # unit); the body's stride period, from the contacts, is that cycle's (its stance command is
+    # the extensor's burst) up to the start-up's first steps in this window (6% open loop).
     w0 = res["windows"][0]
     assert w0["drive"] == 0.0 and w0["start_s"] + 3.0 <= 4.0 + 1e-9
     walk_period_s = build("ml", "walk").period_s()

@@ -14,11 +14,11 @@ Each window also carries the body's stride: ``stride_period_s``, the median inte
 touchdowns of a foot (:mod:`cpgbiped.envs.gaits.gait_metrics`), and ``stride_length_m`` =
 |speed| x stride period; and the network's own cycle, ``cpg_period_s``: the median interval
 between upcrossings of E_ON (the controller's stance command) by the left extensor's
-activation, read from the CPG's signals, never from the body. Speed = stride length / stride
-period, so the picture's middle panel says which of the two a change of speed came from, and
-whether the body's strides follow the network's cycle (README, "Transitions and drive
-sweeps": the Morris-Lecar network's cycle is shortest near d = 0.8, 0.60 s, against the walk's
-1.07 s and the run's 0.72 s).
+activation, read from the CPG's signals, never from the body: with T_cpg that median,
+T_cpg = median(diff(t_k)), t_k the times at which a_LE(t) rises through E_ON. Speed = stride
+length / stride period, so the picture's middle panel says which of the two a change of speed
+came from, and whether the body's strides keep the network's cycle (README, "Why the walk slows
+as the drive rises").
 """
 from __future__ import annotations
 
@@ -104,8 +104,9 @@ def sweep(pair: str, ramp_s: float = 40.0, kind: str = "ml", feedback: float = 0
 
 
 def cycle_period(t_s, activation, t0: float, t1: float) -> float | None:
-    """Median interval (s) between the upcrossings of E_ON by ``activation`` (one cell's, in
-    [0, 1]) inside [t0, t1]; None with fewer than two upcrossings there."""
+    """T = median over k of (t_{k+1} - t_k) (s), t_k the times in [t0, t1] at which
+    ``activation`` (one cell's, in [0, 1], sampled at ``t_s``) rises through E_ON: a_{i-1} < E_ON
+    <= a_i, t_k = t_s[i]. None with fewer than two upcrossings there."""
     t_s, a = np.asarray(t_s, float), np.asarray(activation, float)
     up = t_s[1:][(a[1:] >= E_ON) & (a[:-1] < E_ON)]
     up = up[(up >= t0) & (up <= t1)]
@@ -131,8 +132,9 @@ GAIT_COLORS = {"walk": "tab:green", "run": "tab:red", "jump": "tab:purple", "hop
 
 
 def picture(res: dict, path) -> None:
-    """Speed (top), the body's stride length and stride frequency (middle) and the physical
-    gait (bottom) against the drive, up and down."""
+    """Speed (top), the body's stride length and strides per second with the network's cycles
+    per second beside them (middle; windows at or after a fall left out: a fallen body has no
+    strides) and the physical gait (bottom) against the drive, up and down."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -148,13 +150,21 @@ def picture(res: dict, path) -> None:
         ws = [w for w in res["windows"] if w["leg"] == legname]
         d = [w["drive"] for w in ws]
         a1.plot(d, [w["speed_mps"] for w in ws], ls, color="k", lw=1, label=f"drive {legname}")
-        nan = float("nan")
-        am.plot(d, [nan if w["stride_length_m"] is None else w["stride_length_m"] for w in ws],
-                ls, color="tab:brown", lw=1)
-        af.plot(d, [nan if not w["stride_period_s"] else 1.0 / w["stride_period_s"] for w in ws],
-                ls, color="tab:cyan", lw=1)
-        af.plot(d, [nan if not w["cpg_period_s"] else 1.0 / w["cpg_period_s"] for w in ws],
-                ls, color="tab:blue", lw=0.6, alpha=0.6)
+        nan, fell = float("nan"), res["fell_at_s"]
+
+        def upright(w, key):  # the window's value, NaN in or after a fall
+            x = w[key]
+            late = fell is not None and w["start_s"] + WINDOW_S >= fell
+            return nan if x is None or late else x
+
+        am.plot(d, [upright(w, "stride_length_m") for w in ws], ls, color="tab:brown", lw=1,
+                label="stride (m)" if legname == "up" else None)
+        af.plot(d, [1.0 / upright(w, "stride_period_s") if upright(w, "stride_period_s") else nan
+                    for w in ws], ls, color="tab:cyan", lw=1,
+                label="strides / s" if legname == "up" else None)
+        af.plot(d, [1.0 / upright(w, "cpg_period_s") if upright(w, "cpg_period_s") else nan
+                    for w in ws], ls, color="k", lw=0.6, alpha=0.5,
+                label="CPG cycles / s" if legname == "up" else None)
         for w in ws:
             y = names.index(w["physical_gait"]) + dy
             a2.plot(w["drive"], y, marker, color=GAIT_COLORS.get(w["physical_gait"], "0.3"), ms=5)
@@ -175,6 +185,9 @@ def picture(res: dict, path) -> None:
                  + (f", feedback K = {res['feedback_gain']:g}" if res["feedback_gain"] else "")
                  + ("" if hy is None else f": hysteresis {hy:+.2f}"), fontsize=9)
     a1.legend(fontsize=8, loc="lower right")
+    h1, l1 = am.get_legend_handles_labels()
+    h2, l2 = af.get_legend_handles_labels()
+    am.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper center", ncol=3)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
