@@ -15,8 +15,10 @@ forward push, x_cp - heel for a backward one (m, > 0: the capture point inside t
     python scripts/capture_point.py [--gait jump] --first 1000 --n 40 [--impulse 5] [--at 6]
 
 The front toe: the foremost of the two feet's toe sites (models/biped/biped.xml, 0.17 m ahead
-of the ankle and 0.06 m below it, turned with the foot), a foot in the air included; the rear
-heel: the hindmost heel site (0.07 m behind the ankle). z_com is floored at 0.3 m for omega (a
+of the ankle and 0.06 m below it, turned with the foot: envs.simulation.biped.foot_edges_x), a
+foot in the air included; the rear heel: the hindmost heel site (0.07 m behind the ankle).
+(``validate --json`` reports the same margins over whole rollouts, from the feet on the
+ground only: the margins of stability, ``mos_*``.) z_com is floored at 0.3 m for omega (a
 fallen body only). The margin is a correlate, not a verdict: in a jump the capture point passes
 the toes briefly at every take-off (the minimum before the push is negative) without a fall. Session 45 measured with it why the
 jump falls after a forward push (journal, "Session 45").
@@ -27,35 +29,24 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 G = 9.81
-TOE = (0.17, -0.06)  # m: the toe site in the foot's frame (x forward, z up)
-HEEL = (-0.07, -0.06)  # m: the heel site
 HELD_S = 0.2
 
 
 def margins(job):
     gait, seed, impulse, at_s = job
-    import mujoco
-
     from cpgbiped.cpg.network import build
+    from cpgbiped.envs.simulation.biped import foot_edges_x
     from cpgbiped.envs.simulation.rollout import rollout
 
     rec = rollout(build("ml", gait, seed=seed), at_s + 6.0, push=(at_s, impulse, HELD_S))
     end = int(np.searchsorted(rec.t, at_s + HELD_S))
     if end >= len(rec.t):  # fell before the push ended
         return seed, rec.fell_at, float("nan"), float("nan"), float("nan"), float("nan")
-    m = mujoco.MjModel.from_xml_path(rec.xml_path)
-    edges = []
-    site = TOE if impulse >= 0 else HEEL
-    for side in ("left", "right"):
-        b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, side + "_foot")
-        p, (w, x, y, z) = rec.body_pose[:, b, :3], rec.body_pose[:, b, 3:].T
-        # the x row of the foot's rotation matrix, from its quaternion (w, x, y, z)
-        r00, r02 = 1 - 2 * (y * y + z * z), 2 * (x * z + w * y)
-        edges.append(p[:, 0] + r00 * site[0] + r02 * site[1])
+    toe_x, heel_x = foot_edges_x(rec.body_pose, rec.xml_path)
     t = rec.t
     v = np.gradient(rec.com_x, t)
     cp = rec.com_x + v / np.sqrt(G / np.maximum(rec.com_z, 0.3))
-    margin = np.maximum(*edges) - cp if impulse >= 0 else cp - np.minimum(*edges)
+    margin = toe_x.max(axis=1) - cp if impulse >= 0 else cp - heel_x.min(axis=1)
     both = rec.contact.all(axis=1)
     before = (t > at_s - 4.0) & (t < at_s) & both
     m_before = margin[before] if before.any() else np.array([np.nan])

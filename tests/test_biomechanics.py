@@ -237,3 +237,37 @@ def test_vertical_force_peaks_by_hand():
     peak, when = vertical_force_peaks(c, f, 0.01, 100.0)
     assert peak == pytest.approx((3.0 + 2.0) / 2)
     assert when == pytest.approx((0.15 + 0.55) / 2)
+
+
+def test_foot_edges_are_mujoco_s_own_site_positions(walk):
+    """The toe and heel x that the margins of stability use, rebuilt from the recorded body
+    quaternions, against MuJoCo's forward kinematics of the recorded joint positions (its
+    site_xpos), at every 50th tick of a walk: within a micrometre."""
+    import mujoco
+
+    from cpgbiped.envs.simulation.biped import foot_edges_x
+
+    rec = walk.recording
+    toe_x, heel_x = foot_edges_x(rec.body_pose, rec.xml_path)
+    m = mujoco.MjModel.from_xml_path(rec.xml_path)
+    d = mujoco.MjData(m)
+    for k in range(0, len(rec.t), 50):
+        d.qpos[:] = rec.qpos[k]
+        mujoco.mj_kinematics(m, d)
+        for leg, side in enumerate(("left", "right")):
+            assert toe_x[k, leg] == pytest.approx(d.site(side + "_toe").xpos[0], abs=1e-6)
+            assert heel_x[k, leg] == pytest.approx(d.site(side + "_heel").xpos[0], abs=1e-6)
+
+
+def test_gaits_that_travel_carry_their_extrapolated_com_past_the_toes():
+    """Hof's extrapolated centre of mass x + v / omega (omega = sqrt(g / z)) runs ahead of the
+    centre of mass by v / omega: about 0.28 m at the walk's 0.97 m/s and a 0.8 m pendulum,
+    longer than the stance foot reaches ahead of it, so a walk and a run hold it past the
+    stance toes for most of their stance (forward margin < 0) and catch it with the next
+    landing, while a gait in place keeps it inside its feet (both margins > 0), as standing
+    balance does. Table 3 states, 20 s after settling."""
+    mos = {g: validate(build("ml", g), g, 20.0).summary() for g in ("walk", "run", "jump", "hop")}
+    for g in ("walk", "run"):
+        assert mos[g]["mos_forward_m"] < 0.0 < mos[g]["mos_backward_m"], (g, mos[g])
+    for g in ("jump", "hop"):
+        assert mos[g]["mos_forward_m"] > 0.0 and mos[g]["mos_backward_m"] > 0.0, (g, mos[g])

@@ -242,6 +242,18 @@ class Biomechanics:
                             reaction force on the foot (body weights), and of where in the
                             stance it came (fraction, 0 touchdown; :func:`vertical_force_peaks`):
                             near 0.1 an impact, near the middle a spring's push
+    mos_forward_m, mos_forward_p5_m, mos_backward_m, mos_backward_p5_m, mos_touchdown_m
+                            the anteroposterior margins of stability (Hof, Gazendam & Sinke
+                            2005; :func:`margins_of_stability`): median and 5th percentile over
+                            the samples with a foot on the ground of the distance from the
+                            extrapolated centre of mass x_com + v_com / sqrt(g / z_com) to the
+                            foremost toe (forward) and to the hindmost heel (backward) of the
+                            feet on the ground, m, > 0 inside the base of support; and the
+                            forward margin's median at the touchdowns. A steady walk or run
+                            keeps its extrapolated centre of mass ahead of the stance toe
+                            (< 0) and catches it with the next landing; a gait in place holds
+                            it inside the feet. NaN without recorded body poses (searches
+                            that skip them)
     """
 
     froude: float
@@ -260,6 +272,11 @@ class Biomechanics:
     touch_impulse_per_step_Ns: float = float("nan")
     peak_vertical_grf_bw: float = float("nan")
     peak_vertical_grf_at: float = float("nan")
+    mos_forward_m: float = float("nan")
+    mos_forward_p5_m: float = float("nan")
+    mos_backward_m: float = float("nan")
+    mos_backward_p5_m: float = float("nan")
+    mos_touchdown_m: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -340,6 +357,39 @@ def vertical_force_peaks(contact: np.ndarray, grf_z: np.ndarray, dt: float, weig
     return float(np.median(peak)), float(np.median(when))
 
 
+def margins_of_stability(t: np.ndarray, stance: np.ndarray, com_x: np.ndarray,
+                         com_z: np.ndarray, toe_x: np.ndarray, heel_x: np.ndarray
+                         ) -> tuple[float, float, float, float, float]:
+    """Anteroposterior margins of stability (Hof, Gazendam & Sinke 2005), m.
+
+    The extrapolated centre of mass XcoM = x_com + v_com / omega, omega = sqrt(g / z_com)
+    (v_com = dx_com/dt by central differences, z_com the centre of mass's height: the
+    inverted pendulum's length at each sample); at every sample with a foot on the ground
+    (``stance`` (T, 2), debounced contact), the forward margin is the foremost toe of the feet
+    on the ground minus XcoM, the backward margin XcoM minus their hindmost heel (> 0: XcoM
+    inside the base of support; a body with its XcoM past the toes must step or hop to stop).
+    toe_x, heel_x (T, 2): the world x of each foot's toe and heel. Returns (forward median,
+    forward 5th percentile, backward median, backward 5th percentile, and the forward margin's
+    median over the touchdowns, at the sample each foot lands: the instant gait studies
+    quote for walking, when the landing foot has just widened the base); NaN without a sample
+    on the ground (the last without a touchdown)."""
+    t, stance = np.asarray(t, float), np.asarray(stance, bool)
+    if len(t) < 3 or not stance.any():
+        return (float("nan"),) * 5
+    v = np.gradient(np.asarray(com_x, float), t)
+    xcom = np.asarray(com_x, float) + v / np.sqrt(G / np.maximum(np.asarray(com_z, float), 1e-3))
+    on = stance.any(axis=1)
+    front = np.where(stance, np.asarray(toe_x, float), -np.inf).max(axis=1)[on]
+    rear = np.where(stance, np.asarray(heel_x, float), np.inf).min(axis=1)[on]
+    fwd, back = front - xcom[on], xcom[on] - rear
+    lands = np.zeros_like(on)
+    lands[1:] = (stance[1:] & ~stance[:-1]).any(axis=1)
+    at_td = (np.where(stance, np.asarray(toe_x, float), -np.inf).max(axis=1) - xcom)[lands]
+    return (float(np.median(fwd)), float(np.percentile(fwd, 5)),
+            float(np.median(back)), float(np.percentile(back, 5)),
+            float(np.median(at_td)) if at_td.size else float("nan"))
+
+
 def stride_regularity(touchdowns: dict) -> tuple[float, float]:
     """(stride_cv, period2_index) from each foot's touchdown times (s)."""
     periods = [np.diff(np.asarray(td, float)) for td in touchdowns.values()]
@@ -358,7 +408,9 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
                  min_phase_s: float = MIN_PHASE_S,
                  pitch: np.ndarray | None = None,
                  grf_x: np.ndarray | None = None,
-                 grf_z: np.ndarray | None = None) -> Biomechanics:
+                 grf_z: np.ndarray | None = None,
+                 toe_x: np.ndarray | None = None,
+                 heel_x: np.ndarray | None = None) -> Biomechanics:
     """Biomechanics of a rollout (see :class:`Biomechanics`).
 
     power (T, n_act) W per actuator; leg_joint (n_act,) in {"hip", "knee", "ankle"} and
@@ -366,7 +418,8 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
     metrics of the same window (stride period, touchdowns, speed). pitch (T,): torso pitch
     (rad, > 0 forward), for the trunk lean. grf_x (T, 2): the horizontal ground reaction
     force on each foot (N, > 0 forwards), for the stance impulses; grf_z (T, 2) the vertical
-    one (N, > 0 up), for the peaks."""
+    one (N, > 0 up), for the peaks. toe_x, heel_x (T, 2): the world x of each foot's toe and
+    heel, for the margins of stability."""
     t = np.asarray(t, float)
     sel = t >= settle_s
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
@@ -393,6 +446,11 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
     imp = (stance_impulses(np.asarray(contact, bool)[sel], np.asarray(grf_x, float)[sel], dt,
                            min_phase_s)
            if grf_x is not None and len(grf_x) == len(t) else (float("nan"),) * 3)
+    mos = (margins_of_stability(t[sel], cs, np.asarray(com_x, float)[sel],
+                                np.asarray(com_z, float)[sel], np.asarray(toe_x, float)[sel],
+                                np.asarray(heel_x, float)[sel])
+           if toe_x is not None and heel_x is not None and len(toe_x) == len(t)
+           else (float("nan"),) * 5)
     vz = (vertical_force_peaks(np.asarray(contact, bool)[sel], np.asarray(grf_z, float)[sel], dt,
                                mass_kg * G, min_phase_s)
           if grf_z is not None and len(grf_z) == len(t) else (float("nan"),) * 2)
@@ -408,4 +466,6 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
                         if pitch is not None and sel.any() else float("nan")),
         stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1],
         touch_impulse_per_step_Ns=imp[2], peak_vertical_grf_bw=vz[0],
-        peak_vertical_grf_at=vz[1])
+        peak_vertical_grf_at=vz[1],
+        **dict(zip(("mos_forward_m", "mos_forward_p5_m", "mos_backward_m", "mos_backward_p5_m",
+                    "mos_touchdown_m"), mos)))

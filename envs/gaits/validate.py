@@ -113,23 +113,27 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
                 ankle=rec.joints[sel][:, [2, 5]])
     steady = sel & (rec.t >= settle_s)
     cpg_name = classify(rec.t[steady], rec.cpg_v[steady])[0] if steady.sum() > 16 else "none"
-    from cpgbiped.envs.simulation.biped import body_constants
+    from cpgbiped.envs.simulation.biped import body_constants, foot_edges_x
 
     leg, mass, joint, side = body_constants(rec.xml_path)
+    toe_x = heel_x = None
+    if rec.body_pose.shape[0] == len(rec.t) and len(rec.t):
+        toe_x, heel_x = (e[sel] for e in foot_edges_x(rec.body_pose, rec.xml_path))
     bio = biomechanics(rec.t[sel], rec.contact[sel], rec.com_x[sel], rec.com_z[sel],
                        rec.power[sel], joint, side, m, leg, mass, settle_s,
                        pitch=rec.torso_pitch[sel],
                        grf_x=rec.grf_x[sel] if len(rec.grf_x) == len(rec.t) else None,
-                       grf_z=rec.grf_z[sel] if len(rec.grf_z) == len(rec.t) else None)
+                       grf_z=rec.grf_z[sel] if len(rec.grf_z) == len(rec.t) else None,
+                       toe_x=toe_x, heel_x=heel_x)
     return Validation(network, gait, rec, m, cpg_name, settle_s, ankle_drive, bio)
 
 
 def biomechanics_text(s: dict) -> str:
-    """The biomechanics of one ``Validation.summary()`` as two lines of text (what `validate`
+    """The biomechanics of one ``Validation.summary()`` as three lines of text (what `validate`
     prints under its table; the same numbers as ``--json``): speed, Froude number, stride and
     its length against Alexander's 2.3 Fr^0.3, apex, ankle excursion, stride CV, trunk lean;
     then the ground: the peak vertical force per foot (body weights, where in the stance) and
-    the stance's horizontal impulses."""
+    the stance's horizontal impulses; then the balance: the margins of stability."""
     from cpgbiped.envs.gaits.criteria import alexander_relative_stride
 
     def f(key, p=2, scale=1.0):
@@ -147,7 +151,10 @@ def biomechanics_text(s: dict) -> str:
             f"ground: peak vertical force {f('peak_vertical_grf_bw', 1)} body weights at "
             f"{f('peak_vertical_grf_at')} of the stance; horizontal impulse "
             f"{f('stance_impulse_first_half_Ns', 1)} / {f('stance_impulse_second_half_Ns', 1)} N s "
-            f"(stance first / second half), touches {f('touch_impulse_per_step_Ns', 1)} N s per step")
+            f"(stance first / second half), touches {f('touch_impulse_per_step_Ns', 1)} N s per step\n"
+            f"balance: margin of stability forward {f('mos_forward_m')} m (5th percentile "
+            f"{f('mos_forward_p5_m')}, at touchdown {f('mos_touchdown_m')}), backward "
+            f"{f('mos_backward_m')} m (5th percentile {f('mos_backward_p5_m')})")
 
 
 def metrics_table(summaries: dict[str, dict]) -> str:

@@ -123,6 +123,43 @@ def _constants(path: str, mtime_ns: int):
     return leg_length, mass, np.array(joint), np.array(leg)
 
 
+@functools.lru_cache(maxsize=8)
+def _foot_sites(path: str, mtime_ns: int):
+    m = _compiled(path, mtime_ns)
+    out = []
+    for side in ("left", "right"):
+        try:
+            body = m.body(side + "_foot").id
+            toe, heel = m.site(side + "_toe"), m.site(side + "_heel")
+        except KeyError:
+            raise InputError(f"the model has no {side}_foot body with {side}_toe and "
+                             f"{side}_heel sites: no base of support to measure") from None
+        if int(toe.bodyid[0]) != body or int(heel.bodyid[0]) != body:
+            raise InputError(f"the {side}_toe and {side}_heel sites must belong to {side}_foot")
+        out.append((body, np.array(toe.pos, float), np.array(heel.pos, float)))
+    return out
+
+
+def foot_edges_x(body_pose: np.ndarray, xml_path: str | Path = BIPED_SCENE):
+    """(toe_x, heel_x), each (T, 2) in m (columns left, right): the world x of each foot's toe
+    and heel sites (models/biped/biped.xml: 0.17 m ahead of the ankle and 0.07 m behind it,
+    0.06 m below), from recorded body poses (T, nbody, 7: position, then the orientation
+    quaternion w, x, y, z). With R the foot's rotation matrix and s the site's position in the
+    foot's frame, x = p_x + R[0, 0] s_x + R[0, 1] s_y + R[0, 2] s_z, where
+    R[0] = (1 - 2 (y^2 + z^2), 2 (x y - w z), 2 (x z + w y))."""
+    path = Path(xml_path)
+    sites = _foot_sites(str(path.resolve()), path.stat().st_mtime_ns)
+    pose = np.asarray(body_pose, float)
+    toe = np.empty((pose.shape[0], 2))
+    heel = np.empty((pose.shape[0], 2))
+    for leg, (body, s_toe, s_heel) in enumerate(sites):
+        p, (w, x, y, z) = pose[:, body, :3], pose[:, body, 3:].T
+        r0 = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1)
+        toe[:, leg] = p[:, 0] + r0 @ s_toe
+        heel[:, leg] = p[:, 0] + r0 @ s_heel
+    return toe, heel
+
+
 def body_constants(xml_path: str | Path = BIPED_SCENE):
     """(standing hip height L in m, total mass in kg, the joint kind each actuator drives
     ("hip", "knee", "ankle"), its leg (0 left, 1 right)), read from the model."""
