@@ -17,10 +17,11 @@ forward push, x_cp - heel for a backward one (m, > 0: the capture point inside t
 The front toe: the foremost of the two feet's toe sites (models/biped/biped.xml, 0.17 m ahead
 of the ankle and 0.06 m below it, turned with the foot: envs.simulation.biped.foot_edges_x), a
 foot in the air included; the rear heel: the hindmost heel site (0.07 m behind the ankle).
-(``validate --json`` reports the same margins over whole rollouts, from the feet on the
-ground only: the margins of stability, ``mos_*``.) z_com is floored at 0.3 m for omega (a
-fallen body only). The margin is a correlate, not a verdict: in a jump the capture point passes
-the toes briefly at every take-off (the minimum before the push is negative) without a fall. Session 45 measured with it why the
+z_com is floored at 0.3 m for omega (a fallen body only; gait_metrics.Z_FLOOR_M). The margin
+is a correlate, not a verdict: in a jump the capture point passes the toes briefly at every
+take-off (the minimum before the push is negative) without a fall. (``validate --json``
+reports the margins of stability, ``mos_*``: the same extrapolated centre of mass over a whole
+window, against the feet on the ground only.) Session 45 measured with it why the
 jump falls after a forward push (journal, "Session 45").
 """
 import argparse
@@ -35,6 +36,7 @@ HELD_S = 0.2
 def margins(job):
     gait, seed, impulse, at_s = job
     from cpgbiped.cpg.network import build
+    from cpgbiped.envs.gaits.gait_metrics import Z_FLOOR_M
     from cpgbiped.envs.simulation.biped import foot_edges_x
     from cpgbiped.envs.simulation.rollout import rollout
 
@@ -45,7 +47,7 @@ def margins(job):
     toe_x, heel_x = foot_edges_x(rec.body_pose, rec.xml_path)
     t = rec.t
     v = np.gradient(rec.com_x, t)
-    cp = rec.com_x + v / np.sqrt(G / np.maximum(rec.com_z, 0.3))
+    cp = rec.com_x + v / np.sqrt(G / np.maximum(rec.com_z, Z_FLOOR_M))
     margin = toe_x.max(axis=1) - cp if impulse >= 0 else cp - heel_x.min(axis=1)
     both = rec.contact.all(axis=1)
     before = (t > at_s - 4.0) & (t < at_s) & both

@@ -219,29 +219,31 @@ def test_readme_criteria_table_is_the_criteria_data():
 
 
 def test_margins_of_stability_by_hand():
-    """Hof's margins by construction: at z = g (omega = 1 /s) the extrapolated centre of mass
-    is x + v. A body on its left foot (toe at 0.17 m, heel at -0.07 m) moving at 0.1 m/s from
-    x = 0: XcoM = 0.1 + 0.1 t, forward margin 0.07 - 0.1 t, backward 0.17 + 0.1 t over the
-    samples on the ground; the right foot lands at t = 1 s with its toe at 0.5 m: from then on
-    the front is 0.5 m and the rear heel -0.07 m. In the air nothing counts."""
+    """Hof's margins by construction: at z = g / 4 (omega = 2 /s) the extrapolated centre of
+    mass is x + v / 2. A body on its left foot (toe at 0.17 m, heel at -0.07 m) moving at
+    0.1 m/s from x = 0: XcoM = 0.05 + 0.1 t; the left foot lifts at 0.8 s, the body flies until
+    the right foot lands at 1 s with its toe at 0.5 m and its heel at 0.26 m, and stands on it
+    to the end. Samples in the flight do not count; the touchdown margin is the right foot's at
+    its landing (the body's start on the left foot is not a landing)."""
     from cpgbiped.envs.gaits.gait_metrics import G, margins_of_stability
 
     t = np.arange(0.0, 2.0 + 1e-9, 0.01)
     x = 0.1 * t
-    z = np.full_like(t, G)
+    z = np.full_like(t, G / 4.0)
     stance = np.zeros((len(t), 2), bool)
-    stance[:, 0] = t < 1.5  # the left foot lifts at 1.5 s
-    stance[:, 1] = t >= 1.0  # the right foot lands at 1 s
+    stance[:, 0] = t < 0.8 - 1e-9
+    stance[:, 1] = t >= 1.0 - 1e-9
     toe = np.column_stack([np.full_like(t, 0.17), np.full_like(t, 0.5)])
     heel = np.column_stack([np.full_like(t, -0.07), np.full_like(t, 0.26)])
     fwd_med, fwd_p5, back_med, back_p5, at_td = margins_of_stability(t, stance, x, z, toe, heel)
-    xcom = x + 0.1
-    front = np.where(t < 1.0, 0.17, 0.5)
-    rear = np.where(t < 1.5, -0.07, 0.26)
+    on = stance.any(axis=1)
+    xcom = (x + 0.1 / 2.0)[on]
+    front = np.where(t < 0.8, 0.17, 0.5)[on]
+    rear = np.where(t < 0.8, -0.07, 0.26)[on]
     assert fwd_med == pytest.approx(np.median(front - xcom))
     assert fwd_p5 == pytest.approx(np.percentile(front - xcom, 5))
     assert back_med == pytest.approx(np.median(xcom - rear))
     assert back_p5 == pytest.approx(np.percentile(xcom - rear, 5))
-    assert at_td == pytest.approx(0.5 - (0.1 + 0.1 * 1.0))  # the right foot's landing
+    assert at_td == pytest.approx(0.5 - (0.05 + 0.1 * 1.0))  # the right foot's landing
     air = np.zeros_like(stance)
     assert all(np.isnan(margins_of_stability(t, air, x, z, toe, heel)))

@@ -357,14 +357,20 @@ def vertical_force_peaks(contact: np.ndarray, grf_z: np.ndarray, dt: float, weig
     return float(np.median(peak)), float(np.median(when))
 
 
+Z_FLOOR_M = 0.3  # m: the pendulum length's floor in the margins (reached by a fallen body only)
+
+
 def margins_of_stability(t: np.ndarray, stance: np.ndarray, com_x: np.ndarray,
                          com_z: np.ndarray, toe_x: np.ndarray, heel_x: np.ndarray
                          ) -> tuple[float, float, float, float, float]:
     """Anteroposterior margins of stability (Hof, Gazendam & Sinke 2005), m.
 
     The extrapolated centre of mass XcoM = x_com + v_com / omega, omega = sqrt(g / z_com)
-    (v_com = dx_com/dt by central differences, z_com the centre of mass's height: the
-    inverted pendulum's length at each sample); at every sample with a foot on the ground
+    (v_com = dx_com/dt by central differences; z_com the centre of mass's height at each
+    sample, floored at Z_FLOOR_M, as the inverted pendulum's length: Hof takes a constant
+    length, the leg's; in the gaits with flight, whose stance forces reach 2-3 body weights,
+    the number is descriptive rather than his stability condition); at every sample with a
+    foot on the ground (up to a fall, when the window holds one)
     (``stance`` (T, 2), debounced contact), the forward margin is the foremost toe of the feet
     on the ground minus XcoM, the backward margin XcoM minus their hindmost heel (> 0: XcoM
     inside the base of support; a body with its XcoM past the toes must step or hop to stop).
@@ -377,7 +383,8 @@ def margins_of_stability(t: np.ndarray, stance: np.ndarray, com_x: np.ndarray,
     if len(t) < 3 or not stance.any():
         return (float("nan"),) * 5
     v = np.gradient(np.asarray(com_x, float), t)
-    xcom = np.asarray(com_x, float) + v / np.sqrt(G / np.maximum(np.asarray(com_z, float), 1e-3))
+    xcom = np.asarray(com_x, float) + v / np.sqrt(G / np.maximum(np.asarray(com_z, float),
+                                                                   Z_FLOOR_M))
     on = stance.any(axis=1)
     front = np.where(stance, np.asarray(toe_x, float), -np.inf).max(axis=1)[on]
     rear = np.where(stance, np.asarray(heel_x, float), np.inf).min(axis=1)[on]
@@ -449,7 +456,7 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
     mos = (margins_of_stability(t[sel], cs, np.asarray(com_x, float)[sel],
                                 np.asarray(com_z, float)[sel], np.asarray(toe_x, float)[sel],
                                 np.asarray(heel_x, float)[sel])
-           if toe_x is not None and heel_x is not None and len(toe_x) == len(t)
+           if toe_x is not None and heel_x is not None and len(toe_x) == len(heel_x) == len(t)
            else (float("nan"),) * 5)
     vz = (vertical_force_peaks(np.asarray(contact, bool)[sel], np.asarray(grf_z, float)[sel], dt,
                                mass_kg * G, min_phase_s)
