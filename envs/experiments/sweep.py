@@ -133,8 +133,9 @@ GAIT_COLORS = {"walk": "tab:green", "run": "tab:red", "jump": "tab:purple", "hop
 
 def picture(res: dict, path) -> None:
     """Speed (top), the body's stride length and strides per second with the network's cycles
-    per second beside them (middle; windows at or after a fall left out: a fallen body has no
-    strides) and the physical gait (bottom) against the drive, up and down."""
+    per second beside them (middle) and the physical gait (bottom) against the drive, up and
+    down. The top and middle panels leave out the windows in and after a fall (a fallen body
+    has neither a gait's speed nor strides); an x marks the last window before it."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -149,13 +150,19 @@ def picture(res: dict, path) -> None:
     for legname, ls, marker, dy in (("up", "-", "^", 0.12), ("down", "--", "v", -0.12)):
         ws = [w for w in res["windows"] if w["leg"] == legname]
         d = [w["drive"] for w in ws]
-        a1.plot(d, [w["speed_mps"] for w in ws], ls, color="k", lw=1, label=f"drive {legname}")
         nan, fell = float("nan"), res["fell_at_s"]
 
         def upright(w, key):  # the window's value, NaN in or after a fall
             x = w[key]
             late = fell is not None and w["start_s"] + WINDOW_S >= fell
             return nan if x is None or late else x
+
+        speed = [upright(w, "speed_mps") for w in ws]
+        a1.plot(d, speed, ls, color="k", lw=1, label=f"drive {legname}")
+        kept = [i for i, v in enumerate(speed) if np.isfinite(v)]
+        if fell is not None and kept and kept[-1] < len(ws) - 1:  # the fall comes on this leg
+            a1.plot(d[kept[-1]], speed[kept[-1]], "x", color="k", ms=9, mew=2,
+                    label=f"fell at {fell:.1f} s")
 
         am.plot(d, [upright(w, "stride_length_m") for w in ws], ls, color="tab:brown", lw=1,
                 label="stride (m)" if legname == "up" else None)
