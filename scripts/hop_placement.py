@@ -19,9 +19,8 @@ jump's drift crossed -0.05 m/s, passes 14 -> 2 of 16); the four presets' criteri
 seeds 1000-1031: walk 32 -> 30, jump 28 -> 27.
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 C_V = 0.3
 RULE = ("rule fixed before it was measured on fresh states (CPG seeds 3000-3029): adopt if the "
@@ -37,12 +36,10 @@ RULE = ("rule fixed before it was measured on fresh states (CPG seeds 3000-3029)
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "hp").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"synchronous_coactive.c_v": C_V}, out / "hp" / "gains.json",
-                f"the hop corner's foot-placement speed term 0.054 -> {C_V} rad per m/s: a body "
-                "arriving at a walk's or a run's speed in the hop's rhythm had nothing to brake "
-                "it (scripts/hop_placement.py); " + RULE)
+    hand_set_link(sys.argv[1:], "hp", {"synchronous_coactive.c_v": C_V},
+                  f"the hop corner's foot-placement speed term 0.054 -> {C_V} rad per m/s: a body "
+                  "arriving at a walk's or a run's speed in the hop's rhythm had nothing to brake "
+                  "it (scripts/hop_placement.py); " + RULE)
 
 
 if __name__ == "__main__":

@@ -21,9 +21,8 @@ toes, the margin in front is smaller). The hop corner keeps 0 (at 0.02-0.07 its 
 below the 0.10 its pattern asks).
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 X_BAL = 0.05
 RULE = ("rule fixed before the value met a test condition (out of the tuning seeds only): adopt "
@@ -49,11 +48,9 @@ RULE = ("rule fixed before the value met a test condition (out of the tuning see
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "jb").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"synchronous.x_bal": X_BAL}, out / "jb" / "gains.json",
-                f"the jump corner's balance reference 0 -> {X_BAL} m ahead of the feet's "
-                "centres, over the ball of the foot (scripts/jump_balance_reference.py); " + RULE)
+    hand_set_link(sys.argv[1:], "jb", {"synchronous.x_bal": X_BAL},
+                  f"the jump corner's balance reference 0 -> {X_BAL} m ahead of the feet's "
+                  "centres, over the ball of the foot (scripts/jump_balance_reference.py); " + RULE)
 
 
 if __name__ == "__main__":

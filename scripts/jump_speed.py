@@ -12,9 +12,8 @@ below). Why was not analysed; a likely cause is that both legs swing together in
 the torso takes their reaction, so the thigh target moves the trunk more than the feet.
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 C_V = -0.3
 SWEEP = ("summed tuning cost (walk and jump, tuning conditions 1-16 and 21-24, 20 s, the "
@@ -25,12 +24,10 @@ SWEEP = ("summed tuning cost (walk and jump, tuning conditions 1-16 and 21-24, 2
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "v1").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"synchronous.c_v": C_V}, out / "v1" / "gains.json",
-                f"the jump corner's foot-placement speed term 0.51 -> {C_V}, outside the tuning "
-                "box [0, 0.8]: a Raibert hopper's sign does not carry over to the two-legged "
-                "jump (measured; why not analysed); " + SWEEP)
+    hand_set_link(sys.argv[1:], "v1", {"synchronous.c_v": C_V},
+                  f"the jump corner's foot-placement speed term 0.51 -> {C_V}, outside the tuning "
+                  "box [0, 0.8]: a Raibert hopper's sign does not carry over to the two-legged "
+                  "jump (measured; why not analysed); " + SWEEP)
 
 
 if __name__ == "__main__":

@@ -12,9 +12,8 @@ lift; 0 is the controller before it. Not a search: a rule, measured on the tunin
 before it was adopted (SWEEP).
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 SWEEP = ("tuning cost (the tuner's rollout_cost, 20 s, tuning conditions 1-24, each gait "
          "alone) without -> with: walk 21.24 -> 19.73 (condition 12 named a walk), run 58.57 -> "
@@ -23,11 +22,9 @@ SWEEP = ("tuning cost (the tuner's rollout_cost, 20 s, tuning conditions 1-24, e
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "la").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"lift_abort": 1.0}, out / "la" / "gains.json",
-                "a lift ends while its foot is still down when the other foot leaves the ground "
-                "first (a start-up deadlock: a swinging leg carrying the body); " + SWEEP)
+    hand_set_link(sys.argv[1:], "la", {"lift_abort": 1.0},
+                  "a lift ends while its foot is still down when the other foot leaves the ground "
+                  "first (a start-up deadlock: a swinging leg carrying the body); " + SWEEP)
 
 
 if __name__ == "__main__":

@@ -22,9 +22,8 @@ start-up, whose gains were searched with the target taken at once, lagged); open
 start-up gains hand over, 144 / 171 on the tuning transitions, and adopted by rule H'.
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 TAU_S = 1.0
 RULE = ("rule H' (docs/JOURNAL.md, session 44; fixed in commit 09bdc32, 02:46 on 2026-12-07, before the candidate "
@@ -47,12 +46,10 @@ RULE = ("rule H' (docs/JOURNAL.md, session 44; fixed in commit 09bdc32, 02:46 on
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "pt").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"pitch_tau_s": TAU_S}, out / "pt" / "gains.json",
-                f"pitch_tau_s 0 -> {TAU_S:g}: the trunk's pitch target followed with this time "
-                "constant once the start-up gains have handed over, instead of taken at once "
-                "(scripts/pitch_tau.py); " + RULE)
+    hand_set_link(sys.argv[1:], "pt", {"pitch_tau_s": TAU_S},
+                  f"pitch_tau_s 0 -> {TAU_S:g}: the trunk's pitch target followed with this time "
+                  "constant once the start-up gains have handed over, instead of taken at once "
+                  "(scripts/pitch_tau.py); " + RULE)
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ The search after this link then finds the rest of the corner, its stance knee in
 import sys
 from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 SET = {"alternating_coactive.toe_up": 0.5, "alternating_coactive.theta0": 0.08}
 # what stage rc of scripts/tune_gains.sh searches after it: the run corner's gains that the run's
@@ -56,12 +56,10 @@ def main() -> None:
     if sys.argv[1:] == ["--free"]:
         print(",".join(free_gains()))
         return
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "tc").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, SET, out / "tc" / "gains.json",
-                "the run corner's swing clearance: toe_up 0 -> 0.5 (the swing's dorsiflexion "
-                "early in the swing; the run stubbed its toes), theta0 0.127 -> 0.08 rad to keep "
-                "its speed (scripts/run_toe_clearance.py); " + RULE)
+    hand_set_link(sys.argv[1:], "tc", SET,
+                  "the run corner's swing clearance: toe_up 0 -> 0.5 (the swing's dorsiflexion "
+                  "early in the swing; the run stubbed its toes), theta0 0.127 -> 0.08 rad to keep "
+                  "its speed (scripts/run_toe_clearance.py); " + RULE)
 
 
 if __name__ == "__main__":

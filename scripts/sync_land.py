@@ -18,9 +18,8 @@ jump 100 -> 99 (falls 0 -> 1), the walk 99 -> 100, the run 99 -> 99; over 1000-1
 +5 N s held 0.2 s at 6 s falls 19 -> 10, the jump on friction x0.5 7 -> 4.
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 RULE = ("rule (fixed at 08:22 on 2026-12-06 before the switch met any state outside tuning "
         "states 1000-1099; CPG seeds 2900-2999, unused; `python scripts/rule_rates.py "
@@ -39,12 +38,10 @@ RULE = ("rule (fixed at 08:22 on 2026-12-06 before the switch met any state outs
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "sl").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"sync_land": 1.0}, out / "sl" / "gains.json",
-                "sync_land 0 -> 1: in a synchronous rhythm a foot off the ground while the other "
-                "stands, not lifted by the swing latch, extends to land instead of tucking "
-                "(scripts/sync_land.py); " + RULE)
+    hand_set_link(sys.argv[1:], "sl", {"sync_land": 1.0},
+                  "sync_land 0 -> 1: in a synchronous rhythm a foot off the ground while the other "
+                  "stands, not lifted by the swing latch, extends to land instead of tucking "
+                  "(scripts/sync_land.py); " + RULE)
 
 
 if __name__ == "__main__":

@@ -16,9 +16,8 @@ walk named before 8 s from 13 and 15 of 16 states, open loop and with feedback, 
 measured.
 """
 import sys
-from pathlib import Path
 
-from cpgbiped.envs.search.controller_tuning import set_by_hand
+from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 KNEE_CROUCH = -0.5
 RULE = ("rule, on tuning states only: the walk named over the 5 CPG cycles before 8 s and its "
@@ -34,12 +33,10 @@ RULE = ("rule, on tuning states only: the walk named over the 5 CPG cycles befor
 
 
 def main() -> None:
-    start, out = sys.argv[1], Path(sys.argv[2])
-    (out / "wc").mkdir(parents=True, exist_ok=True)
-    set_by_hand(start, {"alternating.knee_crouch": KNEE_CROUCH}, out / "wc" / "gains.json",
-                f"the walk corner's stance knee target -0.76 -> {KNEE_CROUCH} rad: the walk's "
-                "duty sat at the criterion's edge, so that its start-up and its feedback limped "
-                "(scripts/walk_crouch.py); " + RULE)
+    hand_set_link(sys.argv[1:], "wc", {"alternating.knee_crouch": KNEE_CROUCH},
+                  f"the walk corner's stance knee target -0.76 -> {KNEE_CROUCH} rad: the walk's "
+                  "duty sat at the criterion's edge, so that its start-up and its feedback limped "
+                  "(scripts/walk_crouch.py); " + RULE)
 
 
 if __name__ == "__main__":

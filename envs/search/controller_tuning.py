@@ -821,9 +821,22 @@ def _r(x, nd: int = 4):
         return ""
 
 
+def hand_values(base: ControlParams, values: dict[str, float]) -> ControlParams:
+    """``base`` with ``values`` ({"<corner>.<gain>", "startup.<corner>.<gain>" or a shared
+    name: value}) set, every name checked against the tuner's parameters first."""
+    names = list(values)
+    known = {v[0] for v in variables(TuneSettings(gaits=GAITS, search="both", only=tuple(
+        n.split(".")[-1] for n in names) + tuple(n for n in names if n.startswith(STARTUP))))}
+    bad = [n for n in names if n not in known]
+    if bad:
+        raise InputError(f"unknown gain {', '.join(map(repr, bad))}: use <corner>.<gain>, "
+                         f"startup.<corner>.<gain> or a shared name")
+    return with_values(base, names, [values[n] for n in names])
+
+
 def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, why: str) -> dict:
     """A link of a tuning chain that is not a search: ``start``'s gains with ``values``
-    ({"<corner>.<gain>", "startup.<corner>.<gain>" or a shared name: value}) set by hand,
+    (:func:`hand_values`) set by hand,
     written to ``out`` with a provenance entry (hand_set, what was set and why, and the
     SHA-256 of the values it started from and ended with, as a search's entry has), for a
     search that needs a start outside the basin the previous link ended in
@@ -832,13 +845,7 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
 
     base, provenance = read_gains(start)
     names = list(values)
-    known = {v[0] for v in variables(TuneSettings(gaits=GAITS, search="both", only=tuple(
-        n.split(".")[-1] for n in names) + tuple(n for n in names if n.startswith(STARTUP))))}
-    bad = [n for n in names if n not in known]
-    if bad:
-        raise InputError(f"unknown gain {', '.join(map(repr, bad))}: use <corner>.<gain>, "
-                         f"startup.<corner>.<gain> or a shared name")
-    p = with_values(base, names, [values[n] for n in names])
+    p = hand_values(base, values)
     entry = {"part": sorted({n.rsplit(".", 1)[0] for n in names if "." in n}) or ["shared"],
              "hand_set": True, "set": {n: float(values[n]) for n in names}, "note": why,
              "command": f"set by hand ({', '.join(names)})",
@@ -847,6 +854,16 @@ def set_by_hand(start: str | Path, values: dict[str, float], out: str | Path, wh
     gains = {"format": GAINS_FORMAT, **params_to_dict(p), "provenance": list(provenance) + [entry]}
     write_json(out, gains)
     return gains
+
+
+def hand_set_link(argv: list[str], subdir: str, values: dict[str, float], why: str) -> dict:
+    """The command line of a hand-set link of scripts/tune_gains.sh, ``START.json OUT``:
+    :func:`set_by_hand` from START's gains into OUT/<subdir>/gains.json."""
+    if len(argv) != 2:
+        raise SystemExit("usage: START.json OUT (a link of scripts/tune_gains.sh)")
+    out = Path(argv[1]) / subdir
+    out.mkdir(parents=True, exist_ok=True)
+    return set_by_hand(argv[0], values, out / "gains.json", why)
 
 
 def set_startup(start: str | Path, startup_from: str | Path, tau_s: float, out: str | Path,
