@@ -7,14 +7,15 @@ and length, and the network's own cycle (``cpg_period_s`` of the sweep's windows
 the left extensor's activation through the stance command, read from the CPG's signals):
 
     python scripts/fixed_drive.py walk run [--network ml|hopf] [--drives 0,0.2,...] [--seed S ...]
-                                  [--feedback K] [--set corner.gain=value ...]
+                                  [--feedback K] [--set CORNER.GAIN=VALUE ...]
                                   [--copy FROM=TO]
 
 --seed: random CPG states (default: the Table 3 state); several seeds print one row each.
---set: the committed gains with gains changed (``alternating.theta0=0.1``, a corner's;
-``startup.alternating.theta0=0.1``, a start-up corner's; ``shared.ankle_gain=0.35``): a probe,
-never written anywhere. --copy alternating=alternating_coactive: every gain of corner TO (and of
-its start-up corner) set to corner FROM's, before --set. Session 45 measured with it why
+--set: the committed gains with gains changed, named as the tuning chain's hand-set links name
+them (envs.search.controller_tuning.hand_values: ``alternating.theta0=0.1``, a corner's;
+``startup.alternating.theta0=0.1``, a start-up corner's; ``ankle_gain=0.35``, a shared one): a
+probe, never written anywhere. --copy alternating=alternating_coactive: every gain of corner TO
+(and of its start-up corner) set to corner FROM's, before --set. Session 45 measured with it why
 the walk slows as the sweep's drive rises (README, "Transitions and drive sweeps").
 """
 import argparse
@@ -24,39 +25,20 @@ SECONDS = 20.0
 
 
 def one(job):
-    kind, a, b, d, seed, K, copy, sets = job
+    kind, a, b, d, seed, K, params = job
     import numpy as np
 
     from cpgbiped.cpg.integrate import Schedule
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.control.controller import CONTROL, params_from_dict, params_to_dict
     from cpgbiped.envs.experiments.sweep import cycle_period
     from cpgbiped.envs.gaits.validate import validate
 
-    g = params_to_dict(CONTROL)
-    if copy:
-        src, dst = copy
-        g["corners"][dst] = dict(g["corners"][src])
-        g["startup"]["corners"][dst] = dict(g["startup"]["corners"][src])
-    for key, value in sets:
-        block(g, key)[key.rsplit(".", 1)[1]] = value
     v = validate(build(kind, a, seed=seed), None, SECONDS, to=build(kind, b),
-                 change=Schedule((0.0,), (d,)), params=params_from_dict(g), feedback=K)
+                 change=Schedule((0.0,), (d,)), params=params, feedback=K)
     s, rec = v.summary(), v.recording
     T_cpg = cycle_period(rec.t, rec.drive[:, 2], s["settle_s"], float(rec.t[-1]))
     return (d, seed, s["physical_gait"], s["fell_at_s"], s["speed_mps"], s["stride_period_s"],
             s["stride_length_m"], T_cpg, float(np.mean(list(s["duty_factor"].values()))))
-
-
-def block(g: dict, key: str) -> dict:
-    """The dict of a gains file (params_to_dict form) that holds ``key``: shared.NAME,
-    CORNER.NAME or startup.CORNER.NAME; KeyError when there is none."""
-    part = key.rsplit(".", 1)[0]
-    if part == "shared":
-        return g["shared"]
-    if part.startswith("startup."):
-        return g["startup"]["corners"][part.split(".", 1)[1]]
-    return g["corners"][part]
 
 
 def main() -> None:
@@ -70,10 +52,11 @@ def main() -> None:
     ap.add_argument("--set", nargs="*", default=[], metavar="CORNER.GAIN=VALUE")
     ap.add_argument("--copy", default=None, metavar="FROM=TO")
     args = ap.parse_args()
-    import math
-
+    from cpgbiped.cpg.errors import InputError
     from cpgbiped.cpg.network import PRESETS
-    from cpgbiped.envs.control.controller import CONTROL, params_to_dict
+    from cpgbiped.envs.control import control_kernel as kernel
+    from cpgbiped.envs.control.controller import CONTROL
+    from cpgbiped.envs.search.controller_tuning import hand_values
 
     for p in (args.a, args.b):
         if p not in PRESETS[args.network]:
@@ -86,25 +69,28 @@ def main() -> None:
         ap.error(f"--drives must lie in [0, 1], got {args.drives!r}")
     if not args.seed:
         ap.error("--seed needs at least one CPG seed (leave it out for the Table 3 state)")
-    g, sets = params_to_dict(CONTROL), []
+    values = {}
+    copy = tuple(args.copy.split("=")) if args.copy else None
+    if copy:
+        if len(copy) != 2 or any(c not in kernel.CORNERS for c in copy):
+            ap.error(f"--copy FROM=TO, both corners of {', '.join(kernel.CORNERS)}")
+        src, dst = copy
+        for g in kernel.BLENDED:
+            values[f"{dst}.{g}"] = getattr(CONTROL.corner(src), g)
+            values[f"startup.{dst}.{g}"] = getattr(CONTROL.startup[kernel.CORNERS.index(src)], g)
     for kv in args.set:
         key, _, value = kv.partition("=")
         try:
-            known = key.rsplit(".", 1)[1] in block(g, key)
-            v = float(value)
-        except (KeyError, IndexError, ValueError):
-            known = False
-        if not known or not math.isfinite(v):
-            ap.error(f"--set {kv!r}: shared.NAME, CORNER.NAME or startup.CORNER.NAME = a number")
-        sets.append((key, v))
-    copy = None
-    if args.copy:
-        copy = tuple(args.copy.split("="))
-        if len(copy) != 2 or any(c not in g["corners"] for c in copy):
-            ap.error(f"--copy FROM=TO, both corners of {', '.join(g['corners'])}")
+            values[key] = float(value)
+        except ValueError:
+            ap.error(f"--set {kv!r}: a gain's name = a number")
+    try:
+        params = hand_values(CONTROL, values)
+    except InputError as e:
+        ap.error(str(e))
     if args.network != "ml" and args.feedback:
         ap.error("the closed loop through a parameter change is the Morris-Lecar network's")
-    jobs = [(args.network, args.a, args.b, d, s, args.feedback, copy, sets)
+    jobs = [(args.network, args.a, args.b, d, s, args.feedback, params)
             for d in drives for s in args.seed]
     with ProcessPoolExecutor(2) as ex:
         rows = list(ex.map(one, jobs))
