@@ -17,7 +17,7 @@ forward push, x_cp - heel for a backward one (m, > 0: the capture point inside t
 The front toe: the foremost of the two feet's toe sites (models/biped/biped.xml, 0.17 m ahead
 of the ankle and 0.06 m below it, turned with the foot: envs.simulation.biped.foot_edges_x), a
 foot in the air included; the rear heel: the hindmost heel site (0.07 m behind the ankle).
-z_com is floored at 0.3 m for omega (a fallen body only; gait_metrics.Z_FLOOR_M). The margin
+The capture point is gait_metrics.extrapolated_com (z_com floored at 0.3 m: a fallen body only). The margin
 is a correlate, not a verdict: in a jump the capture point passes the toes briefly at every
 take-off (the minimum before the push is negative) without a fall. (``validate --json``
 reports the margins of stability, ``mos_*``: the same extrapolated centre of mass over a whole
@@ -29,14 +29,13 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-G = 9.81
 HELD_S = 0.2
 
 
 def margins(job):
     gait, seed, impulse, at_s = job
     from cpgbiped.cpg.network import build
-    from cpgbiped.envs.gaits.gait_metrics import Z_FLOOR_M
+    from cpgbiped.envs.gaits.gait_metrics import extrapolated_com
     from cpgbiped.envs.simulation.biped import foot_edges_x
     from cpgbiped.envs.simulation.rollout import rollout
 
@@ -46,14 +45,13 @@ def margins(job):
         return seed, rec.fell_at, float("nan"), float("nan"), float("nan"), float("nan")
     toe_x, heel_x = foot_edges_x(rec.body_pose, rec.xml_path)
     t = rec.t
-    v = np.gradient(rec.com_x, t)
-    cp = rec.com_x + v / np.sqrt(G / np.maximum(rec.com_z, Z_FLOOR_M))
+    cp = extrapolated_com(t, rec.com_x, rec.com_z)
     margin = toe_x.max(axis=1) - cp if impulse >= 0 else cp - heel_x.min(axis=1)
     both = rec.contact.all(axis=1)
     before = (t > at_s - 4.0) & (t < at_s) & both
     m_before = margin[before] if before.any() else np.array([np.nan])
     return (seed, rec.fell_at, float(margin[end]), float(np.median(m_before)),
-            float(np.min(m_before)), float(v[end]))
+            float(np.min(m_before)), float(np.gradient(rec.com_x, t)[end]))
 
 
 def main() -> None:

@@ -360,16 +360,25 @@ def vertical_force_peaks(contact: np.ndarray, grf_z: np.ndarray, dt: float, weig
 Z_FLOOR_M = 0.3  # m: the pendulum length's floor in the margins (reached by a fallen body only)
 
 
+def extrapolated_com(t: np.ndarray, com_x: np.ndarray, com_z: np.ndarray) -> np.ndarray:
+    """Hof's extrapolated centre of mass (the instantaneous capture point), m:
+    XcoM = x_com + v_com / omega, omega = sqrt(g / z_com), v_com = dx_com/dt by central
+    differences, z_com the centre of mass's height at each sample floored at Z_FLOOR_M (the
+    inverted pendulum's length: Hof takes a constant one, the leg's)."""
+    com_x = np.asarray(com_x, float)
+    v = np.gradient(com_x, np.asarray(t, float))
+    return com_x + v / np.sqrt(G / np.maximum(np.asarray(com_z, float), Z_FLOOR_M))
+
+
 def margins_of_stability(t: np.ndarray, stance: np.ndarray, com_x: np.ndarray,
                          com_z: np.ndarray, toe_x: np.ndarray, heel_x: np.ndarray
                          ) -> tuple[float, float, float, float, float]:
     """Anteroposterior margins of stability (Hof, Gazendam & Sinke 2005), m.
 
-    The extrapolated centre of mass XcoM = x_com + v_com / omega, omega = sqrt(g / z_com)
-    (v_com = dx_com/dt by central differences; z_com the centre of mass's height at each
-    sample, floored at Z_FLOOR_M, as the inverted pendulum's length: Hof takes a constant
-    length, the leg's; in the gaits with flight, whose stance forces reach 2-3 body weights,
-    the number is descriptive rather than his stability condition); at every sample with a
+    The extrapolated centre of mass XcoM = x_com + v_com / omega (:func:`extrapolated_com`;
+    with the centre of mass's height as the pendulum's length, in the gaits with flight, whose
+    stance forces reach 2-3 body weights, the number is descriptive rather than Hof's
+    stability condition); at every sample with a
     foot on the ground (up to a fall, when the window holds one)
     (``stance`` (T, 2), debounced contact), the forward margin is the foremost toe of the feet
     on the ground minus XcoM, the backward margin XcoM minus their hindmost heel (> 0: XcoM
@@ -382,9 +391,7 @@ def margins_of_stability(t: np.ndarray, stance: np.ndarray, com_x: np.ndarray,
     t, stance = np.asarray(t, float), np.asarray(stance, bool)
     if len(t) < 3 or not stance.any():
         return (float("nan"),) * 5
-    v = np.gradient(np.asarray(com_x, float), t)
-    xcom = np.asarray(com_x, float) + v / np.sqrt(G / np.maximum(np.asarray(com_z, float),
-                                                                   Z_FLOOR_M))
+    xcom = extrapolated_com(t, com_x, com_z)
     on = stance.any(axis=1)
     front = np.where(stance, np.asarray(toe_x, float), -np.inf).max(axis=1)[on]
     rear = np.where(stance, np.asarray(heel_x, float), np.inf).min(axis=1)[on]
