@@ -78,10 +78,9 @@ def sweep(pair: str, ramp_s: float = 40.0, kind: str = "ml", feedback: float = 0
         v = w["speed_mps"]
         ok = v is not None and np.isfinite(v)
         w["froude"] = float(v * v / (G * leg)) if ok else None
-        T = w.get("stride_period_s")
-        w["stride_period_s"] = float(T) if T is not None and np.isfinite(T) else None
-        w["stride_length_m"] = (float(abs(v) * w["stride_period_s"])
-                                if ok and w["stride_period_s"] is not None else None)
+        T = w["stride_period_s"]
+        w["stride_period_s"] = T = float(T) if T is not None and np.isfinite(T) else None
+        w["stride_length_m"] = float(abs(v) * T) if ok and T is not None else None
         w["cpg_period_s"] = cycle_period(rec.t, rec.drive[:, 2], t0, t0 + WINDOW_S)
         windows.append(w)
         t0 += STEP_S
@@ -166,12 +165,10 @@ def picture(res: dict, path) -> None:
 
         am.plot(d, [upright(w, "stride_length_m") for w in ws], ls, color="tab:brown", lw=1,
                 label="stride (m)" if legname == "up" else None)
-        af.plot(d, [1.0 / upright(w, "stride_period_s") if upright(w, "stride_period_s") else nan
-                    for w in ws], ls, color="tab:cyan", lw=1,
-                label="strides / s" if legname == "up" else None)
-        af.plot(d, [1.0 / upright(w, "cpg_period_s") if upright(w, "cpg_period_s") else nan
-                    for w in ws], ls, color="k", lw=0.6, alpha=0.5,
-                label="CPG cycles / s" if legname == "up" else None)
+        af.plot(d, [1.0 / upright(w, "stride_period_s") for w in ws], ls, color="tab:cyan",
+                lw=1, label="strides / s" if legname == "up" else None)
+        af.plot(d, [1.0 / upright(w, "cpg_period_s") for w in ws], ls, color="k", lw=0.6,
+                alpha=0.5, label="CPG cycles / s" if legname == "up" else None)
         for w in ws:
             y = names.index(w["physical_gait"]) + dy
             a2.plot(w["drive"], y, marker, color=GAIT_COLORS.get(w["physical_gait"], "0.3"), ms=5)
