@@ -16,8 +16,8 @@ This searches ``startup.corners.synchronous_coactive`` (opt-in gains held) with 
 library (ask/tell, seeded), in the unit box of envs.search.controller_tuning.CORNER_RANGES.
 Score of a candidate (lower is better):
 
-- the hop preset from tuning CPG states HOP_SEEDS over 2 s + START_S, open loop from the
-  first half and with the recommended feedback from the second, on the floor frictions
+- the hop preset from tuning CPG states 1000 .. 1000 + n - 1 over 2 s + START_S, open loop
+  from the first half and with the recommended feedback from the second, on the floor frictions
   FRICTIONS in turn (tuning values; the tests use x0.7 and x1.3): per state 10 for a fall plus
   10 x the stride CV over [2 s, 2 s + START_S] (both feet's touchdown intervals pooled, as
   the criteria's stride regularity; capped at 1); averaged;
@@ -25,11 +25,12 @@ Score of a candidate (lower is better):
   10 per fall and 3 per rollout that does not pass its criteria, averaged (the start-up
   corner blends into their first steps too: the features start at their neutral prior).
 
-    python scripts/hop_startup_search.py --start GAINS.json [--out out/hop_startup]
+    python scripts/hop_startup_search.py --start GAINS.json [--n 100] [--gens 10]
+                                         [--out out/hop_startup]
 
 Writes OUT/gains.json (the start file with the corner replaced, as a link of a tuning chain:
 a set_by_hand provenance entry naming this command) and OUT/history.json (every generation's
-best). About 45 minutes on 2 cores.
+best). About 12 minutes on 2 cores (n 100, 10 generations of 12).
 """
 from __future__ import annotations
 
@@ -40,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-HOP_SEEDS = tuple(range(1000, 1060))
+FIRST, N_HOP = 1000, 100  # the hop's tuning CPG states: FIRST .. FIRST + N_HOP - 1 (--n)
 FRICTIONS = (1.0, 0.8, 1.25)
 GUARD_SEEDS = tuple(range(1000, 1008))
 START_S = 8.0  # the hop's scored seconds after the 2 s of settling
@@ -48,13 +49,13 @@ GUARD_S = 12.0
 POP, GENS, SIGMA, SEED = 12, 10, 0.06, 461
 CORNER = "synchronous_coactive"
 NOTE = ("the hop's start-up corner found by python scripts/hop_startup_search.py --start "
-        "{start} --out {out} (cma ask/tell, seed %d, pop %d, %d generations, sigma %g in the "
-        "unit box; tuning CPG states: the hop from %d-%d, the first half open loop and the "
-        "second with the recommended feedback, frictions %s in turn, scored on falls and the "
-        "stride CV over its first %g s after settling; the walk, run and jump from %d-%d as a "
-        "guard, falls and criteria): score {start_score:.3f} -> {score:.3f}, {info}. "
-        % (SEED, POP, GENS, SIGMA, HOP_SEEDS[0], HOP_SEEDS[-1],
-           "/".join(f"x{f:g}" for f in FRICTIONS), START_S, GUARD_SEEDS[0], GUARD_SEEDS[-1]))
+        "{start} --n {n} --gens {gens} --out {out} (cma ask/tell, seed %d, pop %d, sigma %g in the "
+        "unit box; tuning CPG states: the hop from {first}-{last}, the first half open loop "
+        "and the second with the recommended feedback, frictions %s in turn, scored on falls "
+        "and the stride CV over its first %g s after settling; the walk, run and jump from "
+        "%d-%d as a guard, falls and criteria): score {start_score:.3f} -> {score:.3f}, "
+        "{info}. " % (SEED, POP, SIGMA, "/".join(f"x{f:g}" for f in FRICTIONS),
+                      START_S, GUARD_SEEDS[0], GUARD_SEEDS[-1]))
 
 
 def searched_names() -> list:
@@ -72,12 +73,11 @@ def with_corner(base: dict, x_unit: np.ndarray) -> dict:
     return d
 
 
-def hop_jobs(params) -> list:
+def hop_jobs(params, n: int) -> list:
     """(params, seed, friction, feedback gain) of every scored hop rollout."""
     from cpgbiped.cpg.feedback import RECOMMENDED
-    half = len(HOP_SEEDS) // 2
-    return [(params, s, FRICTIONS[i % len(FRICTIONS)], 0.0 if i < half else RECOMMENDED["ml"])
-            for i, s in enumerate(HOP_SEEDS)]
+    return [(params, FIRST + i, FRICTIONS[i % len(FRICTIONS)],
+             0.0 if i < n // 2 else RECOMMENDED["ml"]) for i in range(n)]
 
 
 def hop_terms(job) -> tuple:
@@ -108,11 +108,11 @@ def guard_terms(job) -> tuple:
     return bool(m["fell"]), bool(m["passed"])
 
 
-def score(ex, gains: dict) -> tuple:
-    """(score, summary) of a gains dict."""
+def score(ex, gains: dict, n: int) -> tuple:
+    """(score, summary) of a gains dict, the hop from n tuning states."""
     from cpgbiped.envs.control.controller import params_from_dict
     params = params_from_dict(gains)
-    hop = list(ex.map(hop_terms, hop_jobs(params), chunksize=4))
+    hop = list(ex.map(hop_terms, hop_jobs(params, n), chunksize=4))
     guard = list(ex.map(guard_terms, [(params, g, s) for g in ("walk", "run", "jump")
                                       for s in GUARD_SEEDS], chunksize=2))
     h = np.mean([10 * f + 10 * cv for f, cv in hop])
@@ -130,9 +130,12 @@ def main() -> None:
     from cpgbiped.envs.search.controller_tuning import CORNER_RANGES, set_by_hand
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--start", required=True, help="gains file to start from")
+    ap.add_argument("--n", type=int, default=N_HOP, help="the hop's tuning states, from 1000")
     ap.add_argument("--gens", type=int, default=GENS)
     ap.add_argument("--out", default="out/hop_startup")
     a = ap.parse_args()
+    if not 2 <= a.n <= 100 or a.gens < 1:
+        ap.error("--n must be within 2-100 (tuning states 1000-1099) and --gens at least 1")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     base = json.loads(Path(a.start).read_text())
@@ -144,7 +147,7 @@ def main() -> None:
                                               "verbose": -9})
     history = []
     with ProcessPoolExecutor(2) as ex:
-        best_f, best_info = score(ex, base)
+        best_f, best_info = score(ex, base, a.n)
         best_x = np.array(x0)
         print(f"hop_startup_search: start score {best_f:.3f} {best_info}", flush=True)
         history.append({"gen": -1, "score": best_f, **best_info})
@@ -152,7 +155,7 @@ def main() -> None:
             X = es.ask()
             F = []
             for x in X:
-                f, info = score(ex, with_corner(base, np.asarray(x)))
+                f, info = score(ex, with_corner(base, np.asarray(x)), a.n)
                 F.append(f)
                 if f < best_f:
                     best_f, best_x, best_info = f, np.asarray(x), info
@@ -162,7 +165,8 @@ def main() -> None:
             (out / "history.json").write_text(json.dumps(history, indent=1))
     best = with_corner(base, best_x)["startup"]["corners"][CORNER]
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in names}, out / "gains.json",
-                NOTE.format(start=a.start, out=a.out, score=best_f,
+                NOTE.format(start=a.start, out=a.out, first=FIRST, last=FIRST + a.n - 1,
+                            n=a.n, gens=a.gens, score=best_f,
                             start_score=history[0]["score"], info=json.dumps(best_info))
                 + "(not adopted)")
     print(json.dumps({g: best[g] for g in names}))
