@@ -64,7 +64,7 @@ def test_cost_of_transport_from_force_times_velocity(walk):
     for a in range(m.nu):
         if a < 4:  # the ankle muscles (general, affine gain in the joint angle)
             q = rec.qpos[:, m.jnt_qposadr[m.actuator_trnid[a, 0]]]
-            f = rec.activation[:, a] * (m.actuator_gainprm[a, 0] + m.actuator_gainprm[a, 1] * q)
+            f = rec.muscle_activation[:, a] * (m.actuator_gainprm[a, 0] + m.actuator_gainprm[a, 1] * q)
             tau[:, a] = np.clip(f, *m.actuator_forcerange[a])
         else:
             tau[:, a] = m.actuator_gear[a, 0] * np.clip(rec.ctrl[:, a], -1, 1)

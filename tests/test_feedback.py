@@ -45,9 +45,9 @@ RECORDED = {  # (digest on the first machine, digest on the AVX2 machine)
 
 def _rows(rec) -> np.ndarray:
     """The 45 columns a recording had before the feedback columns were added."""
-    return np.column_stack([rec.t, rec.contact, rec.force, rec.cpg_v, rec.drive, rec.activation,
-                            rec.joints, rec.torso_height, rec.torso_pitch, rec.com_x, rec.com_z,
-                            rec.modes, rec.ctrl, rec.power])
+    return np.column_stack([rec.t, rec.contact, rec.force, rec.cpg_v, rec.drive,
+                            rec.muscle_activation, rec.joints, rec.torso_height, rec.torso_pitch,
+                            rec.com_x, rec.com_z, rec.modes, rec.ctrl, rec.power])
 
 
 @pytest.mark.parametrize("poses", [False, True], ids=["compiled loop", "python loop"])

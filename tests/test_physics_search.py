@@ -222,7 +222,7 @@ def test_compiled_loop_gives_the_python_loops_rows(gait, kw):
     a = rollout(build("ml", gait), 6.0, **kw)
     b = rollout(build("ml", gait), 6.0, poses=False, **kw)
     assert a.fell_at == b.fell_at and a.unstable == b.unstable and len(a.t) == len(b.t)
-    for f in ("t", "contact", "force", "cpg_v", "activation", "joints", "com_x", "com_z",
+    for f in ("t", "contact", "force", "cpg_v", "muscle_activation", "joints", "com_x", "com_z",
               "modes", "ctrl", "power", "grf_x", "grf_z"):
         assert np.array_equal(getattr(a, f), getattr(b, f)), f
     assert b.qpos.shape[0] == 0 and b.body_pose.shape[0] == 0

@@ -116,7 +116,7 @@ def test_blueprint_views_use_the_logged_paths():
     found = {str(v.origin): type(v).__name__ for v in views(bp.root_container)}
     assert found == {"/walk/world": "Spatial3DView", "/walk/video": "Spatial2DView",
                      "/walk/feet": "StateTimelineView", "/walk/cpg": "TimeSeriesView",
-                     "/walk/activation": "TimeSeriesView", "/walk/joints": "TimeSeriesView",
+                     "/walk/muscle_activation": "TimeSeriesView", "/walk/joints": "TimeSeriesView",
                      "/walk/metrics": "TextDocumentView"}
 
 

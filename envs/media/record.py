@@ -14,7 +14,7 @@ Entities, per rollout under ``/<name>`` (e.g. ``/walk``):
                                       ground reaction force, each tick's mean over its physics
                                       steps (the arrows' too), series left, right
   cpg                                 the four CPG cell outputs, series LF, RF, LE, RE
-  activation                          ankle muscle activations, series LF, RF, LE, RE
+  muscle_activation                   ankle muscle activations, series LF, RF, LE, RE
   joints                              hip, knee, ankle angles (rad), series <leg>_<joint>
   torso                               series height (m), pitch (rad)
   feedback                            closed loop only: the feedback term each cell receives
@@ -111,7 +111,8 @@ def log_rollout(rs, name: str, rec, metrics=None, video: str | Path | None = Non
     for path, names, x, colors in (
             ("contacts", LEGS, contact, [FOOT_COLORS[leg] for leg in LEGS]),
             ("force", LEGS, rec.force, [FOOT_COLORS[leg] for leg in LEGS]),
-            ("cpg", CELLS, rec.cpg_v, CELL_COLORS), ("activation", CELLS, rec.activation, CELL_COLORS),
+            ("cpg", CELLS, rec.cpg_v, CELL_COLORS),
+            ("muscle_activation", CELLS, rec.muscle_activation, CELL_COLORS),
             ("joints", JOINTS, rec.joints, JOINT_COLORS),
             ("torso", ("height", "pitch"), torso, CELL_COLORS[:2])) + (
             (("feedback", CELLS, rec.feedback, CELL_COLORS),)
@@ -196,7 +197,7 @@ def blueprint(rollouts: dict, videos: dict | None = None):
                                        time_ranges=follow, time_view=axis),
                  rrb.TimeSeriesView(origin=f"/{n}/cpg", name=f"{n}: CPG cells",
                                     time_ranges=follow),
-                 rrb.TimeSeriesView(origin=f"/{n}/activation", name=f"{n}: ankle muscles",
+                 rrb.TimeSeriesView(origin=f"/{n}/muscle_activation", name=f"{n}: ankle muscles",
                                     time_ranges=follow)] + ([
                  rrb.TimeSeriesView(origin=f"/{n}/feedback", name=f"{n}: feedback into the CPG",
                                     time_ranges=follow)] if rec.feedback_gain > 0 else []) + [

@@ -259,7 +259,7 @@ def signals_picture(rec, path: str | Path, title: str = "") -> Path:
     names = ("LF", "RF", "LE", "RE")
     for c in range(4):
         axes[0].plot(rec.t, rec.cpg_v[:, c], label=names[c], lw=1)
-        axes[1].plot(rec.t, rec.activation[:, c], label=names[c], lw=1)
+        axes[1].plot(rec.t, rec.muscle_activation[:, c], label=names[c], lw=1)
     for j, n in enumerate(("L hip", "L knee", "L ankle", "R hip", "R knee", "R ankle")):
         axes[2].plot(rec.t, rec.joints[:, j], label=n, lw=1)
     axes[0].set_ylabel("CPG v")

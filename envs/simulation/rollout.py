@@ -39,7 +39,8 @@ class Recording:
     force: np.ndarray  # (T, 2) normal force (N)
     cpg_v: np.ndarray  # (T, 4) cell outputs LF, RF, LE, RE
     drive: np.ndarray  # (T, 4) the CPG's activations (the controller's input)
-    activation: np.ndarray  # (T, 4) ankle muscle activation state
+    muscle_activation: np.ndarray  # (T, 4) the ankle muscles' activation state (MuJoCo act,
+    # [0, 1]; the muscles follow their excitation, the controller's ankle controls)
     joints: np.ndarray  # (T, 6) rad
     torso_height: np.ndarray
     torso_pitch: np.ndarray
