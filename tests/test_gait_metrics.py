@@ -247,3 +247,38 @@ def test_margins_of_stability_by_hand():
     assert at_td == pytest.approx(0.5 - (0.05 + 0.1 * 1.0))  # the right foot's landing
     air = np.zeros_like(stance)
     assert all(np.isnan(margins_of_stability(t, air, x, z, toe, heel)))
+
+
+def _touching(tds, t, stance_s=0.2):
+    """Contact of feet that land at the times ``tds`` (one list per foot) and stand stance_s."""
+    c = np.zeros((len(t), 2), bool)
+    for i, times in enumerate(tds):
+        for x in times:
+            c[(t >= x) & (t < x + stance_s), i] = True
+    return c
+
+
+def test_regular_from_is_the_end_of_the_last_irregular_stride():
+    """By construction, feet together (a hop): two stutters 0.4 and 0.25 s apart in the
+    start-up, then strides of 0.64 s from 5.0 s: every stride from 5.0 s on lies within 10%
+    of the settled 0.64 s and the one that ends there does not, so the strides are regular from
+    5.0 s; strides regular from the first touchdown give that touchdown (0.8 s); a stumble at
+    18.0 s (an extra touchdown 0.2 s after a landing of 0.12 s) moves it to the landing that follows the
+    stumble's short interval; a foot that stops stepping half way leaves too few strides; a
+    last stride outside the band never settles."""
+    t = np.arange(0.0, 22.0, 0.004)
+    steady = list(5.0 + 0.64 * np.arange(0, 27))
+    start = [0.8, 1.2, 1.45, 2.1, 2.6, 3.25, 3.5, 4.2, 4.6]
+    assert gm.regular_from(t, _touching([start + steady] * 2, t), 2.0) == pytest.approx(5.0, abs=0.005)
+    regular = list(0.8 + 0.64 * np.arange(0, 33))
+    assert gm.regular_from(t, _touching([regular] * 2, t), 2.0) == pytest.approx(0.8, abs=0.005)
+    # within the band: strides of 0.60 and 0.68 s (6% off) keep it regular
+    wobbly = list(np.cumsum([0.8] + [0.60, 0.68] * 16))
+    assert gm.regular_from(t, _touching([wobbly] * 2, t), 2.0) == pytest.approx(0.8, abs=0.005)
+    stumble = sorted(regular + [x + 0.2 for x in regular if 17.9 < x < 18.2])
+    td = [x for x in regular if 17.9 < x < 18.2][0]
+    got = gm.regular_from(t, _touching([stumble, regular], t, stance_s=0.12), 2.0)
+    assert got == pytest.approx(td + 0.64, abs=0.005)  # the landing after the stumble's 0.44 s interval
+    assert np.isnan(gm.regular_from(t, _touching([[0.8, 1.44, 2.08], [0.8, 1.44]], t), 2.0))
+    late = regular[:-1] + [regular[-2] + 0.3]  # the last stride 0.3 s: still outside
+    assert np.isnan(gm.regular_from(t, _touching([late, late], t), 2.0))

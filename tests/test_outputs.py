@@ -50,6 +50,7 @@ def test_validate_text_prints_the_json_s_biomechanics(capsys):
     assert (f"peak vertical force {s['peak_vertical_grf_bw']:.1f} body weights at "
             f"{s['peak_vertical_grf_at']:.2f} of the stance") in text
     assert f"horizontal impulse {s['stance_impulse_first_half_Ns']:.1f} / " in text
+    assert f"(strides regular from {s['regular_from_s']:.1f} s)" in text
     assert (f"margin of stability forward {s['mos_forward_m']:.2f} m (5th percentile "
             f"{s['mos_forward_p5_m']:.2f}, at touchdown {s['mos_touchdown_m']:.2f})") in text
 

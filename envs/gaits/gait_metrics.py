@@ -254,6 +254,11 @@ class Biomechanics:
                             (< 0) and catches it with the next landing; a gait in place holds
                             it inside the feet. NaN without recorded body poses (searches
                             that skip them)
+    regular_from_s            when the stride became regular, s from the body's start: the
+                            touchdown from which every stride of either foot lies within 10%
+                            of the median stride of the window's second half
+                            (:func:`settling_time`); above the settling period, the window
+                            holds part of the start-up
     """
 
     froude: float
@@ -277,6 +282,7 @@ class Biomechanics:
     mos_backward_m: float = float("nan")
     mos_backward_p5_m: float = float("nan")
     mos_touchdown_m: float = float("nan")
+    regular_from_s: float = float("nan")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -416,6 +422,49 @@ def stride_regularity(touchdowns: dict) -> tuple[float, float]:
     return cv, (float(max(p2)) if p2 else float("nan"))
 
 
+REGULAR_TOL = 0.10  # a regular stride lies within 10% of the settled stride period: twice the
+# 5% stride CV the hop's criterion allows (envs/gaits/criteria.py), about two standard
+# deviations of a regular gait's strides
+
+
+def regular_from(t: np.ndarray, contact: np.ndarray, settle_s: float = 0.0,
+                 min_phase_s: float = MIN_PHASE_S, tol: float = REGULAR_TOL) -> float:
+    """From when on every stride is regular, s from the body's start (t = 0).
+
+    ``t`` (T,) and raw ``contact`` (T, 2) from the start of the rollout. The stride periods
+    are the intervals between successive touchdowns of each foot (debounced as
+    :func:`measure` does), both feet pooled; the settled period P is their median over the
+    intervals that start in the second half of the analysis window [settle_s, t_end]. The
+    result is the touchdown that ends the last interval outside P (1 +- tol), or the first
+    touchdown of either foot when none is outside: from then on every stride of either foot
+    lies within tol of P (a settling time in the strict sense: a stumble late in the window
+    moves it there). NaN when the window's second half holds fewer than 3 intervals (a fall, a
+    body standing still) or when the last interval is still outside. A start-up that stutters
+    (extra touchdowns while the body builds its rhythm up) ends late; a value above
+    ``settle_s`` says that the analysis window holds part of the start-up or a stumble."""
+    t = np.asarray(t, float)
+    if len(t) < 2:
+        return float("nan")
+    dt = float(np.median(np.diff(t)))
+    starts, periods = [], []
+    for i in range(2):
+        td, _ = edges(t, debounce(np.asarray(contact, bool)[:, i], dt, min_phase_s))
+        starts.append(td[:-1])
+        periods.append(np.diff(td))
+    start, period = np.concatenate(starts), np.concatenate(periods)
+    mid = 0.5 * (settle_s + t[-1])
+    late = period[start >= mid]
+    if len(late) < 3:
+        return float("nan")
+    ref = float(np.median(late))
+    off = np.abs(period / ref - 1.0) > tol
+    if not off.any():
+        return float(start.min())
+    ends = start + period
+    end = float(ends[off].max())
+    return end if end < float(ends.max()) else float("nan")
+
+
 def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: np.ndarray,
                  power: np.ndarray, leg_joint: np.ndarray, leg_of: np.ndarray, m: GaitMetrics,
                  leg_length_m: float, mass_kg: float, settle_s: float = 0.0,
@@ -481,5 +530,6 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1],
         touch_impulse_per_step_Ns=imp[2], peak_vertical_grf_bw=vz[0],
         peak_vertical_grf_at=vz[1],
+        regular_from_s=regular_from(t, contact, settle_s, min_phase_s),
         **dict(zip(("mos_forward_m", "mos_forward_p5_m", "mos_backward_m", "mos_backward_p5_m",
                     "mos_touchdown_m"), mos)))

@@ -131,7 +131,8 @@ def measure_recording(network: Network, gait: str | None, rec: Recording, settle
 def biomechanics_text(s: dict) -> str:
     """The biomechanics of one ``Validation.summary()`` as three lines of text (what `validate`
     prints under its table; the same numbers as ``--json``): speed, Froude number, stride and
-    its length against Alexander's 2.3 Fr^0.3, apex, ankle excursion, stride CV, trunk lean;
+    its length against Alexander's 2.3 Fr^0.3, apex, ankle excursion, stride CV and when the
+    strides became regular, trunk lean;
     then the ground: the peak vertical force per foot (body weights, where in the stance) and
     the stance's horizontal impulses; then the balance: the margins of stability."""
     from cpgbiped.envs.gaits.criteria import alexander_relative_stride
@@ -146,8 +147,8 @@ def biomechanics_text(s: dict) -> str:
     return (f"biomechanics: speed {f('speed_mps')} m/s, Fr {f('froude', 3)}, stride "
             f"{f('stride_period_s')} s, stride/leg {f('relative_stride_length')} (Alexander "
             f"{alex}), apex {f('apex_height_m', 1, 100)} cm, ankle excursion "
-            f"{f('ankle_excursion_deg', 0)} deg, stride CV {f('stride_cv', 1, 100)}%, trunk lean "
-            f"{f('trunk_lean_deg', 0)} deg\n"
+            f"{f('ankle_excursion_deg', 0)} deg, stride CV {f('stride_cv', 1, 100)}% (strides "
+            f"regular from {f('regular_from_s', 1)} s), trunk lean {f('trunk_lean_deg', 0)} deg\n"
             f"ground: peak vertical force {f('peak_vertical_grf_bw', 1)} body weights at "
             f"{f('peak_vertical_grf_at')} of the stance; horizontal impulse "
             f"{f('stance_impulse_first_half_Ns', 1)} / {f('stance_impulse_second_half_Ns', 1)} N s "
