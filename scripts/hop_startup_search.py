@@ -29,8 +29,9 @@ Score of a candidate (lower is better):
                                          [--out out/hop_startup]
 
 Writes OUT/gains.json (the start file with the corner replaced, as a link of a tuning chain:
-a set_by_hand provenance entry naming this command) and OUT/history.json (every generation's
-best). About 12 minutes on 2 cores (n 100, 10 generations of 12).
+a set_by_hand provenance entry naming this command; whoever adopts it adds why) and
+OUT/history.json (every generation's best). Session 46's two runs (--n 60 and --n 100, 10
+generations) and the rules that did not adopt them: docs/JOURNAL.md, "Session 46". About 12 minutes on 2 cores (n 100, 10 generations of 12).
 """
 from __future__ import annotations
 
@@ -134,13 +135,16 @@ def main() -> None:
     ap.add_argument("--gens", type=int, default=GENS)
     ap.add_argument("--out", default="out/hop_startup")
     a = ap.parse_args()
-    if not 2 <= a.n <= 100 or a.gens < 1:
-        ap.error("--n must be within 2-100 (tuning states 1000-1099) and --gens at least 1")
+    if not 2 <= a.n <= 100 or not 1 <= a.gens <= 200:
+        ap.error("--n must be within 2-100 (tuning states 1000-1099) and --gens within 1-200")
+    try:
+        base = json.loads(Path(a.start).read_text())
+        c0 = base["startup"]["corners"][CORNER]
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        ap.error(f"--start {a.start}: not a gains file with start-up gains ({e!r})")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    base = json.loads(Path(a.start).read_text())
     names = searched_names()
-    c0 = base["startup"]["corners"][CORNER]
     x0 = [(c0[g] - CORNER_RANGES[g][0]) / (CORNER_RANGES[g][1] - CORNER_RANGES[g][0])
           for g in names]
     es = cma.CMAEvolutionStrategy(x0, SIGMA, {"seed": SEED, "popsize": POP, "bounds": [0, 1],
@@ -167,8 +171,7 @@ def main() -> None:
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in names}, out / "gains.json",
                 NOTE.format(start=a.start, out=a.out, first=FIRST, last=FIRST + a.n - 1,
                             n=a.n, gens=a.gens, score=best_f,
-                            start_score=history[0]["score"], info=json.dumps(best_info))
-                + "(not adopted)")
+                            start_score=history[0]["score"], info=json.dumps(best_info)))
     print(json.dumps({g: best[g] for g in names}))
 
 

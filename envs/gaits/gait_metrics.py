@@ -254,11 +254,11 @@ class Biomechanics:
                             (< 0) and catches it with the next landing; a gait in place holds
                             it inside the feet. NaN without recorded body poses (searches
                             that skip them)
-    regular_from_s            when the stride became regular, s from the body's start: the
-                            touchdown from which every stride of either foot lies within 10%
-                            of the median stride of the window's second half
-                            (:func:`settling_time`); above the settling period, the window
-                            holds part of the start-up
+    regular_from_s          from when on every stride is regular, s from the body's start:
+                            the touchdown from which every stride of either foot lies within
+                            10% of the median stride of the window's second half
+                            (:func:`regular_from`); above the settling period, the window
+                            holds part of the start-up (or a stumble); NaN after a fall
     """
 
     froude: float
@@ -433,36 +433,39 @@ def regular_from(t: np.ndarray, contact: np.ndarray, settle_s: float = 0.0,
 
     ``t`` (T,) and raw ``contact`` (T, 2) from the start of the rollout. The stride periods
     are the intervals between successive touchdowns of each foot (debounced as
-    :func:`measure` does), both feet pooled; the settled period P is their median over the
-    intervals that start in the second half of the analysis window [settle_s, t_end]. The
-    result is the touchdown that ends the last interval outside P (1 +- tol), or the first
-    touchdown of either foot when none is outside: from then on every stride of either foot
-    lies within tol of P (a settling time in the strict sense: a stumble late in the window
-    moves it there). NaN when the window's second half holds fewer than 3 intervals (a fall, a
-    body standing still) or when the last interval is still outside. A start-up that stutters
-    (extra touchdowns while the body builds its rhythm up) ends late; a value above
-    ``settle_s`` says that the analysis window holds part of the start-up or a stumble."""
+    :func:`measure` does); the settled period P is the median of both feet's intervals that
+    start in the second half of the analysis window [settle_s, t_end]. The result is the
+    touchdown that ends the last interval outside P (1 +- tol), or the first touchdown of
+    either foot when none is outside: from then on every stride of either foot lies within tol
+    of P (a settling time in the strict sense: a stumble late in the window moves it there).
+    NaN when either foot has fewer than 2 intervals starting in the window's second half (a
+    foot that stopped stepping, a body standing still) or when either foot's last interval is
+    still outside. A start-up that stutters (extra touchdowns while the body builds its rhythm
+    up) ends late; a value above ``settle_s`` says that the analysis window holds part of the
+    start-up or a stumble. A fallen rollout is the caller's to judge (:func:`biomechanics`
+    reports NaN for it)."""
     t = np.asarray(t, float)
     if len(t) < 2:
         return float("nan")
     dt = float(np.median(np.diff(t)))
-    starts, periods = [], []
+    mid = 0.5 * (settle_s + t[-1])
+    feet = []
     for i in range(2):
         td, _ = edges(t, debounce(np.asarray(contact, bool)[:, i], dt, min_phase_s))
-        starts.append(td[:-1])
-        periods.append(np.diff(td))
-    start, period = np.concatenate(starts), np.concatenate(periods)
-    mid = 0.5 * (settle_s + t[-1])
-    late = period[start >= mid]
-    if len(late) < 3:
-        return float("nan")
-    ref = float(np.median(late))
-    off = np.abs(period / ref - 1.0) > tol
-    if not off.any():
-        return float(start.min())
-    ends = start + period
-    end = float(ends[off].max())
-    return end if end < float(ends.max()) else float("nan")
+        start, period = td[:-1], np.diff(td)
+        if int((start >= mid).sum()) < 2:
+            return float("nan")
+        feet.append((start, period))
+    ref = float(np.median(np.concatenate([p[s >= mid] for s, p in feet])))
+    end, first = -np.inf, np.inf
+    for start, period in feet:
+        off = np.abs(period / ref - 1.0) > tol
+        if off[-1]:
+            return float("nan")
+        first = min(first, float(start[0]))
+        if off.any():
+            end = max(end, float((start + period)[off].max()))
+    return first if not np.isfinite(end) else end
 
 
 def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: np.ndarray,
@@ -530,6 +533,7 @@ def biomechanics(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, com_z: n
         stance_impulse_first_half_Ns=imp[0], stance_impulse_second_half_Ns=imp[1],
         touch_impulse_per_step_Ns=imp[2], peak_vertical_grf_bw=vz[0],
         peak_vertical_grf_at=vz[1],
-        regular_from_s=regular_from(t, contact, settle_s, min_phase_s),
+        regular_from_s=(float("nan") if m.fell else regular_from(t, contact, settle_s,
+                                                                  min_phase_s)),
         **dict(zip(("mos_forward_m", "mos_forward_p5_m", "mos_backward_m", "mos_backward_p5_m",
                     "mos_touchdown_m"), mos)))
