@@ -68,6 +68,8 @@ def test_help_reads_like_a_manual():
     (["log", "--rrd", "x.rrd", "--push", "6", "5", "--push-s", "2"], "[0.004, 1]"),
     (["render", "--out", "x.mp4", "--seconds", "2", "--push", "6", "5"], "lies outside the rollout"),
     (["validate", "--push-s", "0.1"], "--push-s needs --push"),
+    (["validate", "--settle", "-1"], "must be a number of seconds in [0, 120]"),
+    (["validate", "--settle", "nan"], "must be a number of seconds in [0, 120]"),
 ])
 def test_bad_input_one_line_nonzero(args, msg):
     r = run(*args)

@@ -55,6 +55,21 @@ def test_validate_text_prints_the_json_s_biomechanics(capsys):
             f"{s['mos_forward_p5_m']:.2f}, at touchdown {s['mos_touchdown_m']:.2f})") in text
 
 
+def test_validate_settle_moves_the_measured_window(capsys):
+    """--settle S measures the window [S, S + seconds]: the JSON's distance is the centre of
+    mass's travel over that window, as a rollout of the library computes it independently."""
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.simulation.rollout import rollout
+
+    assert main(["validate", "--gait", "walk", "--seconds", "3", "--settle", "5", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    rec = rollout(build("ml", "walk"), 8.0)
+    x = rec.com_x[rec.t >= 5.0]
+    assert s["settle_s"] == 5.0
+    assert s["distance_m"] == pytest.approx(float(x[-1] - x[0]), abs=1e-9)
+    assert abs(s["distance_m"]) > 0.5  # a walk at about 1 m/s travels in those 3 s
+
+
 def test_validate_separates_the_driver_from_the_target(capsys):
     """--network/--preset choose what drives the body, --gait only what the verdict checks."""
     assert main(["validate", "--gait", "walk", "--network", "hopf", "--preset", "jump",

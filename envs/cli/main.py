@@ -91,6 +91,11 @@ PUSH_AFTER_S, MAX_PUSH_AFTER_S, SETTLE_S_CLI = 6.0, 120.0, 2.0
 ML_FORMS_CLI = ("load", "load_antagonist", "angle", "reset", "angle_alternating")
 
 
+def settle_arg(text: str) -> float:
+    return _number(text, 0.0, MAX_PUSH_AFTER_S, False,
+                   f"must be a number of seconds in [0, {MAX_PUSH_AFTER_S:g}]")
+
+
 def push_after_arg(text: str) -> float:
     return _number(text, SETTLE_S_CLI, MAX_PUSH_AFTER_S, False,
                    f"must be a number of seconds in [{SETTLE_S_CLI:g}, {MAX_PUSH_AFTER_S:g}]")
@@ -728,7 +733,7 @@ def cmd_validate(a) -> int:
     from cpgbiped.envs.gaits.validate import biomechanics_text, metrics_table
 
     out_file(a.rrd, "--rrd", ".rrd")
-    v, label = _validation(a)
+    v, label = _validation(a, settle_s=a.settle)
     s = v.summary()
     s["source"] = label
     if a.rrd:
@@ -1110,6 +1115,11 @@ def build_parser() -> argparse.ArgumentParser:
         Times (--push, fell_at_s) are simulation time from the start, settling included.""")
     rollout_args(sp)
     push_args(sp)
+    sp.add_argument("--settle", type=settle_arg, default=SETTLE_S_CLI, metavar="S",
+                    help="seconds of settling before the measured window (default %g, the "
+                    "criteria's, which the tests and the README use); a longer one measures "
+                    "the gait without its start-up (the JSON's regular_from_s says when its "
+                    "strides became regular)" % SETTLE_S_CLI)
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("matrix", cmd_matrix, "every preset of a network through the one controller", """\
