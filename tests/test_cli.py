@@ -70,6 +70,7 @@ def test_help_reads_like_a_manual():
     (["validate", "--push-s", "0.1"], "--push-s needs --push"),
     (["validate", "--settle", "-1"], "must be a number of seconds in [0, 120]"),
     (["validate", "--settle", "nan"], "must be a number of seconds in [0, 120]"),
+    (["validate", "--settle", "120", "--seconds", "600"], "the longest is 602 s"),
 ])
 def test_bad_input_one_line_nonzero(args, msg):
     r = run(*args)

@@ -733,6 +733,11 @@ def cmd_validate(a) -> int:
     from cpgbiped.envs.gaits.validate import biomechanics_text, metrics_table
 
     out_file(a.rrd, "--rrd", ".rrd")
+    from cpgbiped.envs.simulation.rollout import MAX_ROLLOUT_S
+
+    if a.settle + a.seconds > MAX_ROLLOUT_S:
+        raise _input_error(f"--settle {a.settle:g} plus --seconds {a.seconds:g} is a rollout of "
+                           f"{a.settle + a.seconds:g} s; the longest is {MAX_ROLLOUT_S:g} s")
     v, label = _validation(a, settle_s=a.settle)
     s = v.summary()
     s["source"] = label
@@ -1082,7 +1087,8 @@ def build_parser() -> argparse.ArgumentParser:
     def rollout_args(sp, rrd_required=False):
         network_choice(sp, "the target the verdict checks: walk, run, jump or hop (default walk)")
         sp.add_argument("--seconds", type=seconds_arg, default=20.0,
-                        help="simulated seconds measured after 2 s of settling (default 20)")
+                        help="simulated seconds measured after the settling (2 s; validate: "
+                        "--settle) (default 20)")
         sp.add_argument("--seed", type=seed_arg, default=None,
                         help="random initial CPG state from this seed (default: the preset's)")
         sp.add_argument("--friction-scale", type=positive_arg, default=1.0, metavar="F",
@@ -1119,7 +1125,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="seconds of settling before the measured window (default %g, the "
                     "criteria's, which the tests and the README use); a longer one measures "
                     "the gait without its start-up (the JSON's regular_from_s says when its "
-                    "strides became regular)" % SETTLE_S_CLI)
+                    "strides became regular); --seconds are measured after it, and a --push "
+                    "inside it still acts on the body" % SETTLE_S_CLI)
     sp.add_argument("--json", action="store_true", help="print JSON")
 
     sp = add("matrix", cmd_matrix, "every preset of a network through the one controller", """\

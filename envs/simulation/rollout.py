@@ -25,7 +25,8 @@ FALL_HEIGHT = 0.55  # torso (hip) height below which the biped has fallen (m); s
 FALL_PITCH = 1.0  # |torso pitch| above which it has fallen (rad)
 # Any body other than a foot touching the floor (a knee, a shank, the torso) is a fall too.
 MAX_SECONDS = 600.0  # longest measured window (simulated s): bounds memory and time
-# A rollout is the measured window plus the settling before it (criteria.SETTLE_S, 2 s).
+# A rollout is the measured window plus the settling before it (criteria.SETTLE_S, 2 s; what
+# `validate --settle` adds beyond it must fit in this bound too).
 MAX_ROLLOUT_S = MAX_SECONDS + 2.0
 CONTROL_EVERY = 2  # physics steps per control tick (2 ms each: a 4 ms control period)
 
