@@ -21,7 +21,8 @@ Score of a candidate (lower is better):
   FRICTIONS in turn (tuning values; the tests use x0.7 and x1.3): per state 10 for a fall plus
   10 x the stride CV over [2 s, 2 s + START_S] (both feet's touchdown intervals pooled, as
   the criteria's stride regularity; capped at 1); averaged;
-- the guard: the walk, run and jump presets from CPG seeds GUARD_SEEDS over 2 s + GUARD_S,
+- the guard: the walk, run and jump presets from CPG seeds GUARD_SEEDS over 2 s + GUARD_S
+  (scripts/walk_startup_search.py's guard, imported from it),
   10 per fall and 3 per rollout that does not pass its criteria, averaged (the start-up
   corner blends into their first steps too: the features start at their neutral prior).
 
@@ -42,13 +43,22 @@ from pathlib import Path
 
 import numpy as np
 
+# The walk's start-up search (scripts/, on sys.path when a script runs): its unit box, guard
+# rollouts and seeds are this search's too.
+from walk_startup_search import GUARD_SEEDS, guard_terms, searched_names  # noqa: E402
+from walk_startup_search import with_corner as _with_corner  # noqa: E402
+
 FIRST, N_HOP = 1000, 100  # the hop's tuning CPG states: FIRST .. FIRST + N_HOP - 1 (--n)
 FRICTIONS = (1.0, 0.8, 1.25)
-GUARD_SEEDS = tuple(range(1000, 1008))
 START_S = 8.0  # the hop's scored seconds after the 2 s of settling
-GUARD_S = 12.0
 POP, GENS, SIGMA, SEED = 12, 10, 0.06, 461
 CORNER = "synchronous_coactive"
+
+
+def with_corner(base: dict, x_unit: np.ndarray) -> dict:
+    return _with_corner(base, x_unit, CORNER)
+
+
 NOTE = ("the hop's start-up corner found by python scripts/hop_startup_search.py --start "
         "{start} --n {n} --gens {gens} --out {out} (cma ask/tell, seed %d, pop %d, sigma %g in the "
         "unit box; tuning CPG states: the hop from {first}-{last}, the first half open loop "
@@ -57,21 +67,6 @@ NOTE = ("the hop's start-up corner found by python scripts/hop_startup_search.py
         "%d-%d as a guard, falls and criteria): score {start_score:.3f} -> {score:.3f}, "
         "{info}. " % (SEED, POP, SIGMA, "/".join(f"x{f:g}" for f in FRICTIONS),
                       START_S, GUARD_SEEDS[0], GUARD_SEEDS[-1]))
-
-
-def searched_names() -> list:
-    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES, OPT_IN
-    return [g for g in CORNER_RANGES if g not in OPT_IN]
-
-
-def with_corner(base: dict, x_unit: np.ndarray) -> dict:
-    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES
-    d = json.loads(json.dumps(base))
-    c = d["startup"]["corners"][CORNER]
-    for g, u in zip(searched_names(), x_unit):
-        lo, hi = CORNER_RANGES[g]
-        c[g] = float(lo + (hi - lo) * np.clip(u, 0.0, 1.0))
-    return d
 
 
 def hop_jobs(params, n: int) -> list:
@@ -94,19 +89,6 @@ def hop_terms(job) -> tuple:
     s = measure_recording(net, "hop", rec, SETTLE_S).summary()
     cv = s.get("stride_cv")
     return bool(s["fell"]), float(1.0 if cv is None or not np.isfinite(cv) else min(cv, 1.0))
-
-
-def guard_terms(job) -> tuple:
-    """(fell, passed its criteria) of a guarded preset over 2 s + GUARD_S."""
-    params, gait, seed = job
-    from cpgbiped.cpg.network import build
-    from cpgbiped.envs.gaits.criteria import SETTLE_S
-    from cpgbiped.envs.gaits.validate import measure_recording
-    from cpgbiped.envs.simulation.rollout import rollout
-    net = build("ml", gait, seed=seed)
-    rec = rollout(net, SETTLE_S + GUARD_S, params, poses=False)
-    m = measure_recording(net, gait, rec, SETTLE_S).summary()
-    return bool(m["fell"]), bool(m["passed"])
 
 
 def score(ex, gains: dict, n: int) -> tuple:

@@ -86,10 +86,12 @@ def searched_names() -> list:
     return [g for g in CORNER_RANGES if g not in OPT_IN]
 
 
-def with_corner(base: dict, x_unit: np.ndarray) -> dict:
+def with_corner(base: dict, x_unit: np.ndarray, corner: str = CORNER) -> dict:
+    """``base`` with the start-up corner ``corner``'s searched gains set from a point of the
+    unit box (scripts/hop_startup_search.py searches the hop's through it)."""
     from cpgbiped.envs.search.controller_tuning import CORNER_RANGES
     d = json.loads(json.dumps(base))
-    c = d["startup"]["corners"][CORNER]
+    c = d["startup"]["corners"][corner]
     for g, u in zip(searched_names(), x_unit):
         lo, hi = CORNER_RANGES[g]
         c[g] = float(lo + (hi - lo) * np.clip(u, 0.0, 1.0))
