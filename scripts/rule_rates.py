@@ -36,7 +36,8 @@ backward pushes (scripts/envelope_census.py, session 42); 5780-5909 rule G, the 
 feedback (session 43: the presets 5780-5879, the transitions 5880-5909); 5910-6039 rule H, the
 trunk's posture followed at a rate (session 44: the transitions 5910-5939, the presets
 5940-6039), 6040-6169 rule H', the same opened over the start-up (the transitions 6040-6069, the
-presets 6070-6169). Unused: 6170 and up.
+presets 6070-6169); 6170-6269 and 6270-6369 rules J and J', the hop's start-up corner (session
+46); 6370-6469 rule K, the jump's capture response (session 47). Unused: 6470 and up.
 The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a
 note (re-counting that rule is what it is for then).
 """
@@ -59,7 +60,8 @@ PERTURBATIONS = {"unperturbed": {}, "friction x0.5": {"friction_scale": 0.5},
 USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 2419), (2450, 2479),
               (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099), (5100, 5199),
               (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519), (5520, 5579),
-              (5580, 5759), (5760, 5779), (5780, 5909), (5910, 6039), (6040, 6169))
+              (5580, 5759), (5760, 5779), (5780, 5909), (5910, 6039), (6040, 6169),
+              (6170, 6369), (6370, 6469))
 
 
 def one(job):

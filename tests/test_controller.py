@@ -173,8 +173,11 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
 
     # the walk corner of stage w4, the start-up gains' walk corner until session 35 (its own
     # search then replaced it there): tests/data/walk_corner_w4.json
-    w4_corner = Corner(**json.loads((Path(__file__).parent / "data" / "walk_corner_w4.json")
-                                    .read_text())["corner"])
+    from cpgbiped.envs.control.control_kernel import ADDED_NEUTRAL
+
+    # (a gain added after the file was written reads as its neutral value, as gains files do)
+    w4_corner = Corner(**{**ADDED_NEUTRAL, **json.loads(
+        (Path(__file__).parent / "data" / "walk_corner_w4.json").read_text())["corner"]})
     w4 = replace(CONTROL, alternating=w4_corner, startup=(w4_corner, *CONTROL.startup[1:]))
     off = w4.with_corner("alternating", push_off=0.0, knee_hold=0.0)
     on = w4.with_corner("alternating", push_off=0.3, knee_hold=1.0)

@@ -32,15 +32,15 @@ SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
-           "land_yield", "x_bal", "lean_knee", "toe_up")
+           "land_yield", "x_bal", "lean_knee", "toe_up", "capture_place", "capture_ankle")
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
-                 "lean_knee": 0.0, "toe_up": 0.0}
+                 "lean_knee": 0.0, "toe_up": 0.0, "capture_place": 0.0, "capture_ankle": 0.0}
 ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0, "sync_land": 0.0, "pitch_tau_s": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
-ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up")
+ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up", "capture_place", "capture_ankle")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -98,6 +98,14 @@ SENSOR_FX_FROM_FZ = -2  # the contact sensor's force x lies two slots before its
 
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (biped.xml)
+# The toe and heel sites in the foot's frame (x forward, z up, from the ankle; biped.xml).
+TOE_X, HEEL_X, SOLE_Z = 0.17, -0.07, -0.06
+G_MPS2 = 9.81
+Z_PENDULUM_MIN_M = 0.3  # m: the extrapolated centre of mass's floor (gait_metrics.Z_FLOOR_M)
+# The capture response acts on two feet side by side (their toes closer than this), a stance
+# with no step to take; a foot counts as on its toes (heel) past this ankle angle.
+CAPTURE_TOGETHER_M = 0.1
+CAPTURE_TILT_RAD = 0.15
 
 
 FEATURE_PRIOR = 0.3  # mean square activation of a cell that bursts a third of its cycle
@@ -132,6 +140,33 @@ def _clip1(x):
 @njit(cache=True, inline="always")
 def _clip01(x):
     return min(1.0, max(0.0, x))
+
+
+@njit(cache=True)
+def beyond_feet(qpos, sens, xpos, ix, com_x, com_v):
+    """How far Hof's extrapolated centre of mass XcoM = x_com + v_com / sqrt(g / z_com) lies
+    ahead of the foremost toe (m, > 0) or behind the hindmost heel (< 0) while the two feet
+    are side by side (toes within CAPTURE_TOGETHER_M), on the ground or not; 0 otherwise.
+    Toe and heel from the foot's angle in the plane, a = rooty + hip + knee + ankle (every
+    hinge about 0 -1 0): x = x_ankle + x_site cos(a) - z_site sin(a)."""
+    toe_max, toe_min, heel_min = -1e9, 1e9, 1e9
+    for i in range(2):
+        a = qpos[ix[IX_ROOTY_Q]]
+        for j in range(3):
+            a += qpos[ix[IX_JOINTS + 3 * i + j]]
+        x0 = xpos[ix[IX_FOOT + i], 0]
+        c, s = math.cos(a), math.sin(a)
+        toe = x0 + TOE_X * c - SOLE_Z * s
+        heel = x0 + HEEL_X * c - SOLE_Z * s
+        toe_max, toe_min, heel_min = max(toe_max, toe), min(toe_min, toe), min(heel_min, heel)
+    if toe_max - toe_min >= CAPTURE_TOGETHER_M:
+        return 0.0
+    xcom = com_x + com_v / math.sqrt(G_MPS2 / max(sens[ix[IX_COM] + 2], Z_PENDULUM_MIN_M))
+    if xcom > toe_max:
+        return xcom - toe_max
+    if xcom < heel_min:
+        return xcom - heel_min
+    return 0.0
 
 
 @njit(cache=True)
@@ -215,13 +250,15 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                     G[n] += w01 * (nu_ac - nu) * (P[P_SIZE + 4 * n + 1] - P[m])
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
-     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee, toe_up) = (
+     swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee, toe_up,
+     capture_place, capture_ankle) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
         G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24], G[25],
-        G[26], G[27])
+        G[26], G[27], G[28], G[29])
     push_off = max(0.0, push_off)
     knee_hold = _clip01(knee_hold)
     land_yield = _clip01(land_yield)
+    capture_ankle = _clip01(capture_ankle)
     # Swing drive: own flexor, the other leg's extensor (crossed), or the silence of the own
     # extensor alone (swing_rest), all while the own extensor is silent.
     for i in range(2):
@@ -250,6 +287,12 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         knee[i] = qpos[ix[IX_KNEE_Q + i]]
         knee_rate[i] = qvel[ix[IX_KNEE_V + i]]
         foot_x[i] = xpos[ix[IX_FOOT + i], 0] + FOOT_CENTRE_X
+    # The capture response (the controller's docstring, 4 and 3): in a rhythm whose legs push
+    # together, how far the extrapolated centre of mass lies beyond the toes (> 0) or behind
+    # the heels (< 0) of two feet side by side.
+    beyond = 0.0
+    if (capture_place != 0.0 or capture_ankle > 0.0) and sigma >= SIGMA_LIFT:
+        beyond = beyond_feet(qpos, sens, xpos, ix, com_x, com_v)
 
     # Latches, one per leg, that follow the CPG's bursts, never a clock.
     # "pushed": the leg took off during its extensor burst (it stood on the ground in this
@@ -345,10 +388,17 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         b = k_ax * (com_x - sup_x - x_bal) + k_av * com_v
         for i in range(2):
             if mode[i] == MODE_SUPPORT:
-                if b > 0:
-                    u[2 + i] = min(u[2 + i] + b, 1.0)
+                bi = b
+                # capture_ankle: the reflex withholds this share of its push on a foot already
+                # on its toes (heel) once the extrapolated centre of mass is past them
+                q_ankle = qpos[ix[IX_JOINTS + 3 * i + 2]]
+                if (b > 0 and beyond > 0 and q_ankle < -CAPTURE_TILT_RAD) or (
+                        b < 0 and beyond < 0 and q_ankle > CAPTURE_TILT_RAD):
+                    bi *= 1.0 - capture_ankle
+                if bi > 0:
+                    u[2 + i] = min(u[2 + i] + bi, 1.0)
                 else:
-                    u[i] = min(u[i] - b, 1.0)
+                    u[i] = min(u[i] - bi, 1.0)
         ref_x = sup_x
     else:
         ref_x = com_x
@@ -359,7 +409,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
         u[2 + trailing] = min(u[2 + trailing] + push_off, 1.0)
 
     # Hips: legs off the ground (or lifting) place the foot; support legs hold the torso.
-    theta = theta0 + c_v * com_v + c_d * (com_x - ref_x)
+    theta = theta0 + c_v * com_v + c_d * (com_x - ref_x) + capture_place * beyond
     tau_hip = np.zeros(2)
     swing_sum = 0.0
     for i in range(2):

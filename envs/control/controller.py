@@ -69,7 +69,18 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    (x_foot the foot's centre; kernel.TOE_UP_BEHIND_M = 0.1 m): the swing's dorsiflexion that
    clears the toes, as the human tibialis anterior does (a tucked shank otherwise points the
    passive foot's toes at the floor, and the run stubbed them); it has faded before the
-   landing. ``--no-ankle-drive``
+   landing. The capture response (blended capture_ankle in [0, 1], neutral 0): in a rhythm
+   whose legs push together (sigma >= SIGMA_LIFT) with the two feet side by side (toes within
+   kernel.CAPTURE_TOGETHER_M = 0.1 m), let
+       beyond = XcoM - x_toe,max  if XcoM > x_toe,max;   XcoM - x_heel,min  if XcoM < x_heel,min;
+       0 otherwise,   XcoM = x_com + v_com / sqrt(g / max(z_com, 0.3 m))
+   (Hof's extrapolated centre of mass; toe and heel the sites of biped.xml at the feet's angles
+   in the plane; kernel.beyond_feet), and beyond = 0 in any other rhythm or stance. A support
+   foot turned onto its toes (ankle below -kernel.CAPTURE_TILT_RAD = -0.15 rad) while beyond > 0
+   gets b (1 - capture_ankle) instead of b > 0, and onto its heel (ankle above 0.15 rad) while
+   beyond < 0 likewise for b < 0: past the toes the ankles can move the centre of pressure no
+   further, and plantarflexing more only rolls the foot onto its toes and shortens the base of
+   support (about 6 cm at 0.6 rad). ``--no-ankle-drive``
    sets ankle_gain = 0 (the reflexes stay).
 4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
    tau_torso = kp_t (pitch_d' - pitch) - kd_t pitch_rate, with the pitch target
@@ -92,7 +103,10 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    pitch_d differ (a transition, a rhythm between corners); in a settled gait p_t = pitch_d;
    legs in the air or lifting place the foot (Raibert / SIMBICON foot placement), with the
    thigh angle in the world as target
-       theta = theta0 + c_v v_com + c_d (x_com - x_sup)   (x_sup = x_com with no support),
+       theta = theta0 + c_v v_com + c_d (x_com - x_sup) + capture_place beyond
+       (x_sup = x_com with no support; beyond as in step 3, the capture response: blended
+       capture_place, rad per m, neutral 0, 15 at the jump's corner since session 47 if rule K
+       adopts it; the feet go where the extrapolated centre of mass has gone),
        tau_i = kp_sw (theta - thigh_i) - kd_sw thigh_rate_i  [ - kf_t tau_torso in flight ];
    support legs share what holds the torso: tau_i = (tau_torso - sum of the others' tau) / n.
 5. Knees:
@@ -196,6 +210,10 @@ class Corner:
     x_bal: float  # m: the balance reflex's reference, this far ahead of the support feet's centre
     lean_knee: float  # rad of trunk pitch target per rad of mean knee flexion
     toe_up: float  # swing: dorsiflexor activation added while the foot is behind the hip
+    capture_place: float  # rad of a placing thigh's target per m of the extrapolated centre of
+    # mass beyond two feet side by side (docstring, 4)
+    capture_ankle: float  # share (0-1) of the balance reflex withheld from a foot on its toes
+    # (heel) once that centre of mass is past them (docstring, 3)
 
 
 @dataclass(frozen=True)
