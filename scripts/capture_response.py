@@ -37,7 +37,8 @@ from concurrent.futures import ProcessPoolExecutor
 PLACE, ANKLE = 15.0, 1.0  # rad/m, share: the jump's corner (synchronous)
 GRID = ((0.0, 0.0), (10.0, 1.0), (15.0, 1.0), (20.0, 1.0), (30.0, 1.0), (10.0, 0.0), (0.0, 1.0))
 CONDITIONS = ((5.0, 1.0), (-5.0, 1.0), (0.0, 1.0), (0.0, 0.5), (0.0, 2.0))  # (N s at 6 s, friction)
-RULE = "rule K (docs/JOURNAL.md, session 47): not yet measured"
+RULE = ("rule K (docs/JOURNAL.md, session 47): not met (in-family transitions 7 -> 5 of 16, "
+        "cross-family 6 -> 3 of 8), not adopted")
 
 
 def _fell(job):
