@@ -591,3 +591,121 @@ def test_pitch_tau_s_follows_the_blended_trunk_target_at_its_rate():
             continue
         assert first == pytest.approx(hop, abs=1e-9)
         assert second == pytest.approx(hop + (1.0 - np.exp(-dt / tau)) * (jump - hop), abs=1e-9)
+
+
+def _posed(ankle_rad=0.0, vx=0.0, hips=(0.0, 0.0)):
+    """The biped lifted off the floor with both feet side by side, its ankles at ankle_rad
+    and its root moving forwards at vx (m/s); MuJoCo's forward pass and sensors evaluated."""
+    m, d = lifted_body()
+    for leg, hip in zip(("left", "right"), hips):
+        d.qpos[m.jnt_qposadr[m.joint(f"{leg}_hip").id]] = hip
+        d.qpos[m.jnt_qposadr[m.joint(f"{leg}_ankle").id]] = ankle_rad
+    d.qvel[m.jnt_dofadr[m.joint("rootx").id]] = vx
+    mujoco.mj_forward(m, d)
+    return m, d
+
+
+@pytest.mark.parametrize("ankle_rad,vx,hips", [
+    (0.0, 3.0, (0.0, 0.0)),  # thrown forwards: the XcoM past the toes
+    (-0.5, 3.0, (0.0, 0.0)),  # on its toes (a shorter base)
+    (0.3, -3.0, (0.0, 0.0)),  # thrown backwards, on its heels: behind the heels
+    (0.0, 0.1, (0.0, 0.0)),  # inside the feet
+    (0.0, 3.0, (0.5, 0.0)),  # one foot forwards: not side by side
+])
+def test_beyond_feet_is_the_extrapolated_com_past_the_toe_and_heel_sites(ankle_rad, vx, hips):
+    """The capture response's input (kernel.beyond_feet) against an independent computation
+    from MuJoCo's own quantities: the toe and heel sites' world positions (site_xpos) and the
+    whole body's centre of mass and its velocity (subtree_com and mj_subtreeVel at the root
+    body), Hof's XcoM = x + v / sqrt(g / z): how far it lies ahead of the foremost toe or
+    behind the hindmost heel while the toes are within 0.1 m of each other, else 0."""
+    m, d = _posed(ankle_rad, vx, hips)
+    mujoco.mj_subtreeVel(m, d)
+    torso = m.body("torso").id
+    x, z = d.subtree_com[torso, 0], d.subtree_com[torso, 2]
+    xcom = x + d.subtree_linvel[torso, 0] / np.sqrt(9.81 / z)
+    toes = [d.site(f"{leg}_toe").xpos[0] for leg in ("left", "right")]
+    heels = [d.site(f"{leg}_heel").xpos[0] for leg in ("left", "right")]
+    if abs(toes[0] - toes[1]) >= 0.1:
+        want = 0.0
+    elif xcom > max(toes):
+        want = xcom - max(toes)
+    elif xcom < min(heels):
+        want = xcom - min(heels)
+    else:
+        want = 0.0
+    from cpgbiped.envs.control.controller import kernel_index
+
+    ix = kernel_index(m)
+    got = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
+                        d.sensordata[ix[K.IX_COMVEL]])
+    assert got == pytest.approx(want, abs=1e-9)
+    assert (got != 0.0) == (hips == (0.0, 0.0) and abs(vx) > 1.0)  # the cases say what they test
+
+
+def _jump_controls(params, ankle_rad, vx, lifted):
+    """The 8 controls of one tick at the jump's corner (the features set to sigma = 1, kappa = 0
+    by hand) for the posed body: standing (t = 0, both feet count as on the ground for
+    contact_hold) or lifted (the last ground contact long ago: both legs in the air)."""
+    from dataclasses import replace
+
+    from cpgbiped.envs.control.controller import kernel_index, params_array
+
+    m, d = _posed(ankle_rad, vx)
+    S = K.new_state()
+    S[K.S_C_LR] = S[K.S_V_L] = S[K.S_V_R] = 1.0  # extensors in phase: sigma = 1 / (1 + 1e-3)
+    S[K.S_C_FE], S[K.S_V_F], S[K.S_V_E] = 0.0, 1.0, 1.0  # flexor and extensor apart: kappa = 0
+    t_s = 0.0
+    if lifted:
+        S[K.S_LAST_GROUND:K.S_LAST_GROUND + 2] = -10.0
+        t_s = 5.0
+    u = np.zeros(8)
+    a = np.array([0.0, 0.0, 0.2, 0.2])  # the extensors' burst beginning: stance command off
+    K.control_from(t_s, a, params_array(replace(params, startup=None)), S, d.qpos, d.qvel,
+                   d.sensordata, d.xpos, kernel_index(m), u)
+    return u, m, d
+
+
+def test_capture_place_moves_the_placing_thighs_by_the_xcom_beyond_the_toes():
+    """Step 4 of the controller's docstring: a leg placing its foot aims its thigh at theta +
+    capture_place * beyond. Both legs in the air, the XcoM past the toes (thrown forwards): the
+    hip torque changes by kp_sw * w * capture_place * beyond, w = sigma (1 - kappa) the jump
+    corner's share and kp_sw the blended swing stiffness, both read from the parameters, and
+    beyond from the sites (the test above)."""
+    from cpgbiped.envs.control.controller import kernel_index
+
+    place = 1.0  # rad/m: small enough that no hip torque reaches its clip
+    u0, m, d = _jump_controls(CONTROL, 0.0, 1.2, lifted=True)
+    u1, _, _ = _jump_controls(CONTROL.with_corner("synchronous", capture_place=place), 0.0, 1.2,
+                              lifted=True)
+    ix = kernel_index(m)
+    beyond = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
+                           d.sensordata[ix[K.IX_COMVEL]])
+    assert beyond > 0.05
+    w = 1.0 / (1.0 + 1e-3)  # sigma as the kernel measures it from the averages set, kappa = 0
+    kp_sw = w * CONTROL.synchronous.kp_sw + (1 - w) * CONTROL.alternating.kp_sw  # kappa = 0
+    assert np.all(np.abs(u1[4:6]) < 1.0)
+    np.testing.assert_allclose(u1[4:6] - u0[4:6], kp_sw * w * place * beyond, rtol=1e-9)
+    np.testing.assert_array_equal(u1[[0, 1, 2, 3, 6, 7]], u0[[0, 1, 2, 3, 6, 7]])
+
+
+@pytest.mark.parametrize("ankle_rad,withheld", [(-0.3, True), (0.0, False)])
+def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, withheld):
+    """Step 3: standing, with the XcoM past the toes, the balance reflex adds b > 0 to the
+    extensors; with capture_ankle = 1 (at every corner, so that the blend is 1) a foot turned
+    onto its toes (ankle below -0.15 rad) gets none of it: its extensor gets what it gets with
+    the reflex's gains k_ax = k_av = 0 (the CPG's drive and the push-off); a flat foot all of
+    it."""
+    def every_corner(**gains):
+        p = CONTROL
+        for c in K.CORNERS:
+            p = p.with_corner(c, **gains)
+        return p
+
+    u0, _, _ = _jump_controls(CONTROL, ankle_rad, 3.0, lifted=False)
+    u1, _, _ = _jump_controls(every_corner(capture_ankle=1.0), ankle_rad, 3.0, lifted=False)
+    u_none, _, _ = _jump_controls(every_corner(k_ax=0.0, k_av=0.0), ankle_rad, 3.0, lifted=False)
+    assert np.all(u0[2:4] > u_none[2:4] + 0.5)  # the reflex pushes (b > 0) without the response
+    if withheld:
+        np.testing.assert_allclose(u1[2:4], u_none[2:4], rtol=1e-12)
+    else:
+        np.testing.assert_array_equal(u1, u0)

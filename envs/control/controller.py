@@ -105,8 +105,10 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    thigh angle in the world as target
        theta = theta0 + c_v v_com + c_d (x_com - x_sup) + capture_place beyond
        (x_sup = x_com with no support; beyond as in step 3, the capture response: blended
-       capture_place, rad per m, neutral 0, 15 at the jump's corner since session 47 if rule K
-       adopts it; the feet go where the extrapolated centre of mass has gone),
+       capture_place, rad per m, neutral 0; the feet go where the extrapolated centre of mass
+       has gone; 0 with capture_ankle 0 in the committed gains: 15 and 1 at the jump's corner
+       kept every test perturbation but failed rule K on the transitions, journal session 47,
+       scripts/capture_response.py),
        tau_i = kp_sw (theta - thigh_i) - kd_sw thigh_rate_i  [ - kf_t tau_torso in flight ];
    support legs share what holds the torso: tau_i = (tau_torso - sum of the others' tau) / n.
 5. Knees:
