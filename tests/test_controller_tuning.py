@@ -798,3 +798,43 @@ def test_rule_rates_refuses_the_tuning_and_test_states(monkeypatch, capsys):
             rr.main()
         assert e.value.code == 2
         assert "overlap" in capsys.readouterr().err
+
+
+def test_condition_coins_counts_rule_k_s_clause_with_its_limits():
+    """scripts/condition_coins.py: re-roll r moves theta0 by r x eps at every corner and start-up
+    corner and nothing else (r = 0: the committed gains); the clause counts each kind of
+    single condition and applies rule K3's limits (open loop >= 12 of 13 each, with feedback
+    no more than one below the baseline, perturbations >= 15 of 16, matrices 4/4, in-family >= 6,
+    cross-family >= 4). Synthetic outcomes, counted by hand."""
+    cc = _script("condition_coins")
+    assert cc.params_for(0, 1e-6) is CONTROL
+    p = cc.params_for(3, 1e-6)
+    for name in CORNER_OF.values():
+        assert p.corner(name).theta0 == pytest.approx(CONTROL.corner(name).theta0 + 3e-6,
+                                                      abs=1e-15)
+        assert p.corner(name).kp_sw == CONTROL.corner(name).kp_sw
+    assert all(a.theta0 == pytest.approx(b.theta0 + 3e-6, abs=1e-15)
+               for a, b in zip(p.startup, CONTROL.startup))
+
+    def held(ol_fail=0, fb_fail=0, pert=16, fam=7, cross=6):
+        h = {}
+        for g in cc.GAITS:
+            for fb, fails in ((False, ol_fail), (True, fb_fail)):
+                for k in range(13):
+                    h[("validate", g, f"c{k}", fb)] = k >= fails
+            for k, (pid, _) in enumerate(cc.PERTURBATIONS):
+                h[("validate", g, pid, False)] = 4 * cc.GAITS.index(g) + k < pert
+            h[("validate", g, "state7", False)] = True
+            h[("matrix", g)] = True
+        for k in range(16):
+            h[("in-family", k)] = k < fam
+        for k in range(8):
+            h[("cross", k)] = k < cross
+        return h
+
+    base, ok = cc.clause(held(), None)
+    assert ok and base["perturbations"] == 16 and base["in-family"] == 7 and base["cross"] == 6
+    assert base[("conditions", "hop", True)] == 13
+    assert cc.clause(held(ol_fail=1, fb_fail=1, pert=15, fam=6, cross=4), base)[1]
+    for bad in (dict(ol_fail=2), dict(fb_fail=2), dict(pert=14), dict(fam=5), dict(cross=3)):
+        assert not cc.clause(held(**bad), base)[1], bad
