@@ -28,7 +28,9 @@ past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's exc
 40 against 21). Over tuning
 states 1000-1099 (x1.0, x0.7, x1.3 open loop and x1.0 with K = 0.03) the jump passes validate
 in 399 of 400 with either gains, the hop in 361 and 358. capture_place 15 and capture_ankle 1
-were put to rule K (docs/JOURNAL.md, session 47).
+were put to rule K (docs/JOURNAL.md, session 47), in a form that read "on its toes" from the
+ankle joint's angle; the kernel now reads the foot's tilt in the world, and --grid gives the
+same counts in every cell.
 """
 import argparse
 import sys

@@ -593,32 +593,38 @@ def test_pitch_tau_s_follows_the_blended_trunk_target_at_its_rate():
         assert second == pytest.approx(hop + (1.0 - np.exp(-dt / tau)) * (jump - hop), abs=1e-9)
 
 
-def _posed(ankle_rad=0.0, vx=0.0, hips=(0.0, 0.0)):
-    """The biped lifted off the floor with both feet side by side, its ankles at ankle_rad
-    and its root moving forwards at vx (m/s); MuJoCo's forward pass and sensors evaluated."""
+def _posed(ankle_rad=0.0, vx=0.0, hips=(0.0, 0.0), knee_rad=0.0, rooty_rad=0.0):
+    """The biped lifted off the floor, its hips at ``hips``, both knees at knee_rad, both
+    ankles at ankle_rad, its trunk's hinge at rooty_rad (< 0 leans it forwards) and its root
+    moving forwards at vx (m/s); MuJoCo's forward pass and sensors evaluated."""
     m, d = lifted_body()
+    d.qpos[m.jnt_qposadr[m.joint("rooty").id]] = rooty_rad
     for leg, hip in zip(("left", "right"), hips):
         d.qpos[m.jnt_qposadr[m.joint(f"{leg}_hip").id]] = hip
+        d.qpos[m.jnt_qposadr[m.joint(f"{leg}_knee").id]] = knee_rad
         d.qpos[m.jnt_qposadr[m.joint(f"{leg}_ankle").id]] = ankle_rad
     d.qvel[m.jnt_dofadr[m.joint("rootx").id]] = vx
     mujoco.mj_forward(m, d)
     return m, d
 
 
-@pytest.mark.parametrize("ankle_rad,vx,hips", [
-    (0.0, 3.0, (0.0, 0.0)),  # thrown forwards: the XcoM past the toes
-    (-0.5, 3.0, (0.0, 0.0)),  # on its toes (a shorter base)
-    (0.3, -3.0, (0.0, 0.0)),  # thrown backwards, on its heels: behind the heels
-    (0.0, 0.1, (0.0, 0.0)),  # inside the feet
-    (0.0, 3.0, (0.5, 0.0)),  # one foot forwards: not side by side
+@pytest.mark.parametrize("ankle_rad,vx,hips,knee_rad,rooty_rad", [
+    (0.0, 3.0, (0.0, 0.0), 0.0, 0.0),  # thrown forwards: the XcoM past the toes
+    (-0.5, 3.0, (0.0, 0.0), 0.0, 0.0),  # on its toes (a shorter base)
+    (0.3, -3.0, (0.0, 0.0), 0.0, 0.0),  # thrown backwards, on its heels: behind the heels
+    (0.2, 3.0, (0.6, 0.6), -0.8, -0.2),  # crouched, leaning: every term of the foot's angle
+    (0.2, -3.0, (0.6, 0.6), -0.8, -0.2),
+    (0.0, 0.1, (0.0, 0.0), 0.0, 0.0),  # inside the feet
+    (0.0, 3.0, (0.5, 0.0), 0.0, 0.0),  # one foot forwards: not side by side
 ])
-def test_beyond_feet_is_the_extrapolated_com_past_the_toe_and_heel_sites(ankle_rad, vx, hips):
+def test_beyond_feet_is_the_extrapolated_com_past_the_toe_and_heel_sites(ankle_rad, vx, hips,
+                                                                         knee_rad, rooty_rad):
     """The capture response's input (kernel.beyond_feet) against an independent computation
     from MuJoCo's own quantities: the toe and heel sites' world positions (site_xpos) and the
     whole body's centre of mass and its velocity (subtree_com and mj_subtreeVel at the root
     body), Hof's XcoM = x + v / sqrt(g / z): how far it lies ahead of the foremost toe or
     behind the hindmost heel while the toes are within 0.1 m of each other, else 0."""
-    m, d = _posed(ankle_rad, vx, hips)
+    m, d = _posed(ankle_rad, vx, hips, knee_rad, rooty_rad)
     mujoco.mj_subtreeVel(m, d)
     torso = m.body("torso").id
     x, z = d.subtree_com[torso, 0], d.subtree_com[torso, 2]
@@ -639,10 +645,10 @@ def test_beyond_feet_is_the_extrapolated_com_past_the_toe_and_heel_sites(ankle_r
     got = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
                         d.sensordata[ix[K.IX_COMVEL]])
     assert got == pytest.approx(want, abs=1e-9)
-    assert (got != 0.0) == (hips == (0.0, 0.0) and abs(vx) > 1.0)  # the cases say what they test
+    assert (got != 0.0) == (hips[0] == hips[1] and abs(vx) > 1.0)  # the cases say what they test
 
 
-def _jump_controls(params, ankle_rad, vx, lifted):
+def _jump_controls(params, ankle_rad, vx, lifted, crouch=False):
     """The 8 controls of one tick at the jump's corner (the features set to sigma = 1, kappa = 0
     by hand) for the posed body: standing (t = 0, both feet count as on the ground for
     contact_hold) or lifted (the last ground contact long ago: both legs in the air)."""
@@ -650,7 +656,8 @@ def _jump_controls(params, ankle_rad, vx, lifted):
 
     from cpgbiped.envs.control.controller import kernel_index, params_array
 
-    m, d = _posed(ankle_rad, vx)
+    m, d = (_posed(ankle_rad, vx, (0.4, 0.4), -0.8, 0.0) if crouch  # the foot flat: 0.4 - 0.8
+            else _posed(ankle_rad, vx))                           # + 0.4 = 0
     S = K.new_state()
     S[K.S_C_LR] = S[K.S_V_L] = S[K.S_V_R] = 1.0  # extensors in phase: sigma = 1 / (1 + 1e-3)
     S[K.S_C_FE], S[K.S_V_F], S[K.S_V_E] = 0.0, 1.0, 1.0  # flexor and extensor apart: kappa = 0
@@ -683,29 +690,42 @@ def test_capture_place_moves_the_placing_thighs_by_the_xcom_beyond_the_toes():
     assert beyond > 0.05
     w = 1.0 / (1.0 + 1e-3)  # sigma as the kernel measures it from the averages set, kappa = 0
     kp_sw = w * CONTROL.synchronous.kp_sw + (1 - w) * CONTROL.alternating.kp_sw  # kappa = 0
-    assert np.all(np.abs(u1[4:6]) < 1.0)
+    assert np.all(np.abs(u0[4:6]) < 1.0) and np.all(np.abs(u1[4:6]) < 1.0)
     np.testing.assert_allclose(u1[4:6] - u0[4:6], kp_sw * w * place * beyond, rtol=1e-9)
     np.testing.assert_array_equal(u1[[0, 1, 2, 3, 6, 7]], u0[[0, 1, 2, 3, 6, 7]])
 
 
-@pytest.mark.parametrize("ankle_rad,withheld", [(-0.3, True), (0.0, False)])
-def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, withheld):
-    """Step 3: standing, with the XcoM past the toes, the balance reflex adds b > 0 to the
-    extensors; with capture_ankle = 1 (at every corner, so that the blend is 1) a foot turned
-    onto its toes (ankle below -0.15 rad) gets none of it: its extensor gets what it gets with
-    the reflex's gains k_ax = k_av = 0 (the CPG's drive and the push-off); a flat foot all of
-    it."""
+@pytest.mark.parametrize("ankle_rad,vx,crouch,withheld", [
+    (-0.3, 3.0, False, True),  # on its toes, the XcoM past them: the extensors' push withheld
+    (0.0, 3.0, False, False),  # flat: kept
+    (0.3, -3.0, False, True),  # on its heels, the XcoM behind them: the flexors' pull withheld
+    (0.4, -3.0, True, False),  # crouched with the ankle joint at 0.4 rad but the foot flat: kept
+])
+def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, vx, crouch,
+                                                                   withheld):
+    """Step 3: standing, with the XcoM past the toes (behind the heels), the balance reflex
+    adds b > 0 to the extensors (-b to the flexors); with capture_ankle = 1 (at every corner,
+    so that the blend is 1) a foot tilted onto its toes (heel) in the world, past 0.15 rad,
+    gets none of it: its muscles get what they get with the reflex's gains k_ax = k_av = 0 (the
+    CPG's drive and the push-off); a flat foot all of it, whatever its ankle joint's angle."""
     def every_corner(**gains):
         p = CONTROL
         for c in K.CORNERS:
             p = p.with_corner(c, **gains)
         return p
 
-    u0, _, _ = _jump_controls(CONTROL, ankle_rad, 3.0, lifted=False)
-    u1, _, _ = _jump_controls(every_corner(capture_ankle=1.0), ankle_rad, 3.0, lifted=False)
-    u_none, _, _ = _jump_controls(every_corner(k_ax=0.0, k_av=0.0), ankle_rad, 3.0, lifted=False)
-    assert np.all(u0[2:4] > u_none[2:4] + 0.5)  # the reflex pushes (b > 0) without the response
+    from cpgbiped.envs.control.controller import kernel_index
+
+    u0, m, d = _jump_controls(CONTROL, ankle_rad, vx, False, crouch)
+    ix = kernel_index(m)
+    beyond = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
+                           d.sensordata[ix[K.IX_COMVEL]])
+    assert np.sign(beyond) == np.sign(vx)  # the XcoM has left the feet in every case
+    u1, _, _ = _jump_controls(every_corner(capture_ankle=1.0), ankle_rad, vx, False, crouch)
+    u_none, _, _ = _jump_controls(every_corner(k_ax=0.0, k_av=0.0), ankle_rad, vx, False, crouch)
+    muscles = slice(2, 4) if vx > 0 else slice(0, 2)  # b > 0: extensors; b < 0: flexors
+    assert np.all(u0[muscles] > u_none[muscles] + 0.5)  # the reflex acts without the response
     if withheld:
-        np.testing.assert_allclose(u1[2:4], u_none[2:4], rtol=1e-12)
+        np.testing.assert_allclose(u1[muscles], u_none[muscles], rtol=1e-12)
     else:
         np.testing.assert_array_equal(u1, u0)

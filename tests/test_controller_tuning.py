@@ -804,8 +804,10 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits():
     """scripts/condition_coins.py: re-roll r moves theta0 by r x eps at every corner and start-up
     corner and nothing else (r = 0: the committed gains); the clause counts each kind of
     single condition and applies rule K3's limits (open loop >= 12 of 13 each, with feedback
-    no more than one below the baseline, perturbations >= 15 of 16, matrices 4/4, in-family >= 6,
-    cross-family >= 4). Synthetic outcomes, counted by hand."""
+    no more than one below the baseline, the jump standing with feedback, perturbations >= 15
+    of 16, matrices 4/4, in-family >= 6, cross-family >= 4). Synthetic outcomes, counted by
+    hand (outcomes(), which turns rollouts into them, is checked by re-roll 0 reproducing the
+    README's status: journal, session 47)."""
     cc = _script("condition_coins")
     assert cc.params_for(0, 1e-6) is CONTROL
     p = cc.params_for(3, 1e-6)
@@ -816,7 +818,7 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits():
     assert all(a.theta0 == pytest.approx(b.theta0 + 3e-6, abs=1e-15)
                for a, b in zip(p.startup, CONTROL.startup))
 
-    def held(ol_fail=0, fb_fail=0, pert=16, fam=7, cross=6):
+    def held(ol_fail=0, fb_fail=0, pert=16, fam=7, cross=6, jump_stands=True):
         h = {}
         for g in cc.GAITS:
             for fb, fails in ((False, ol_fail), (True, fb_fail)):
@@ -830,11 +832,13 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits():
             h[("in-family", k)] = k < fam
         for k in range(8):
             h[("cross", k)] = k < cross
+        h[("jump no fall with feedback",)] = jump_stands
         return h
 
     base, ok = cc.clause(held(), None)
     assert ok and base["perturbations"] == 16 and base["in-family"] == 7 and base["cross"] == 6
     assert base[("conditions", "hop", True)] == 13
     assert cc.clause(held(ol_fail=1, fb_fail=1, pert=15, fam=6, cross=4), base)[1]
-    for bad in (dict(ol_fail=2), dict(fb_fail=2), dict(pert=14), dict(fam=5), dict(cross=3)):
+    for bad in (dict(ol_fail=2), dict(fb_fail=2), dict(pert=14), dict(fam=5), dict(cross=3),
+                dict(jump_stands=False)):
         assert not cc.clause(held(**bad), base)[1], bad

@@ -23,6 +23,8 @@ from cpgbiped.cpg.feedback import advance as fb_advance
 from cpgbiped.cpg.feedback import blend_at as fb_blend_at
 from cpgbiped.cpg.feedback import inputs as fb_inputs
 from cpgbiped.cpg.feedback import outputs as fb_outputs
+from cpgbiped.envs.gaits.gait_metrics import G as G_MPS2
+from cpgbiped.envs.gaits.gait_metrics import Z_FLOOR_M
 
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in
@@ -98,12 +100,12 @@ SENSOR_FX_FROM_FZ = -2  # the contact sensor's force x lies two slots before its
 
 CONTACT_N = 1.0  # N: a foot carrying at least this normal force is on the ground
 FOOT_CENTRE_X = 0.05  # m: the foot's centre lies this far ahead of the ankle (biped.xml)
-# The toe and heel sites in the foot's frame (x forward, z up, from the ankle; biped.xml).
+# The toe and heel sites in the foot's frame (x forward, z up, from the ankle; biped.xml;
+# tests/test_controller.py checks them against MuJoCo's site positions).
 TOE_X, HEEL_X, SOLE_Z = 0.17, -0.07, -0.06
-G_MPS2 = 9.81
-Z_PENDULUM_MIN_M = 0.3  # m: the extrapolated centre of mass's floor (gait_metrics.Z_FLOOR_M)
 # The capture response acts on two feet side by side (their toes closer than this), a stance
-# with no step to take; a foot counts as on its toes (heel) past this ankle angle.
+# with no step to take; a foot counts as on its toes (heel) once it is tilted past this angle
+# in the world, toes down (up).
 CAPTURE_TOGETHER_M = 0.1
 CAPTURE_TILT_RAD = 0.15
 
@@ -142,18 +144,26 @@ def _clip01(x):
     return min(1.0, max(0.0, x))
 
 
+@njit(cache=True, inline="always")
+def foot_angle(qpos, ix, i):
+    """Leg i's foot angle in the plane, rad: rooty + hip + knee + ankle (every hinge turns about
+    0 -1 0), > 0 toes up; 0 flat when the body stands upright."""
+    a = qpos[ix[IX_ROOTY_Q]]
+    for j in range(3):
+        a += qpos[ix[IX_JOINTS + 3 * i + j]]
+    return a
+
+
 @njit(cache=True)
 def beyond_feet(qpos, sens, xpos, ix, com_x, com_v):
-    """How far Hof's extrapolated centre of mass XcoM = x_com + v_com / sqrt(g / z_com) lies
-    ahead of the foremost toe (m, > 0) or behind the hindmost heel (< 0) while the two feet
-    are side by side (toes within CAPTURE_TOGETHER_M), on the ground or not; 0 otherwise.
-    Toe and heel from the foot's angle in the plane, a = rooty + hip + knee + ankle (every
-    hinge about 0 -1 0): x = x_ankle + x_site cos(a) - z_site sin(a)."""
+    """How far Hof's extrapolated centre of mass XcoM = x_com + v_com / sqrt(g / max(z_com,
+    Z_FLOOR_M)) lies ahead of the foremost toe (m, > 0) or behind the hindmost heel (< 0)
+    while the two feet are side by side (toes within CAPTURE_TOGETHER_M), on the ground or
+    not; 0 otherwise. Toe and heel from the foot's angle a (:func:`foot_angle`):
+    x = x_ankle + x_site cos(a) - z_site sin(a)."""
     toe_max, toe_min, heel_min = -1e9, 1e9, 1e9
     for i in range(2):
-        a = qpos[ix[IX_ROOTY_Q]]
-        for j in range(3):
-            a += qpos[ix[IX_JOINTS + 3 * i + j]]
+        a = foot_angle(qpos, ix, i)
         x0 = xpos[ix[IX_FOOT + i], 0]
         c, s = math.cos(a), math.sin(a)
         toe = x0 + TOE_X * c - SOLE_Z * s
@@ -161,7 +171,7 @@ def beyond_feet(qpos, sens, xpos, ix, com_x, com_v):
         toe_max, toe_min, heel_min = max(toe_max, toe), min(toe_min, toe), min(heel_min, heel)
     if toe_max - toe_min >= CAPTURE_TOGETHER_M:
         return 0.0
-    xcom = com_x + com_v / math.sqrt(G_MPS2 / max(sens[ix[IX_COM] + 2], Z_PENDULUM_MIN_M))
+    xcom = com_x + com_v / math.sqrt(G_MPS2 / max(sens[ix[IX_COM] + 2], Z_FLOOR_M))
     if xcom > toe_max:
         return xcom - toe_max
     if xcom < heel_min:
@@ -391,10 +401,11 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
                 bi = b
                 # capture_ankle: the reflex withholds this share of its push on a foot already
                 # on its toes (heel) once the extrapolated centre of mass is past them
-                q_ankle = qpos[ix[IX_JOINTS + 3 * i + 2]]
-                if (b > 0 and beyond > 0 and q_ankle < -CAPTURE_TILT_RAD) or (
-                        b < 0 and beyond < 0 and q_ankle > CAPTURE_TILT_RAD):
-                    bi *= 1.0 - capture_ankle
+                if beyond != 0.0:
+                    tilt = foot_angle(qpos, ix, i)
+                    if (b > 0 and beyond > 0 and tilt < -CAPTURE_TILT_RAD) or (
+                            b < 0 and beyond < 0 and tilt > CAPTURE_TILT_RAD):
+                        bi *= 1.0 - capture_ankle
                 if bi > 0:
                     u[2 + i] = min(u[2 + i] + bi, 1.0)
                 else:

@@ -70,17 +70,19 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
    clears the toes, as the human tibialis anterior does (a tucked shank otherwise points the
    passive foot's toes at the floor, and the run stubbed them); it has faded before the
    landing. The capture response (blended capture_ankle in [0, 1], neutral 0): in a rhythm
-   whose legs push together (sigma >= SIGMA_LIFT) with the two feet side by side (toes within
-   kernel.CAPTURE_TOGETHER_M = 0.1 m), let
+   whose legs push together (sigma >= SIGMA_LIFT; also in every gait's first few tenths of a
+   second, while sigma is near its neutral prior of 0.5) with the two feet side by side (toes
+   within kernel.CAPTURE_TOGETHER_M = 0.1 m), let
        beyond = XcoM - x_toe,max  if XcoM > x_toe,max;   XcoM - x_heel,min  if XcoM < x_heel,min;
        0 otherwise,   XcoM = x_com + v_com / sqrt(g / max(z_com, 0.3 m))
    (Hof's extrapolated centre of mass; toe and heel the sites of biped.xml at the feet's angles
-   in the plane; kernel.beyond_feet), and beyond = 0 in any other rhythm or stance. A support
-   foot turned onto its toes (ankle below -kernel.CAPTURE_TILT_RAD = -0.15 rad) while beyond > 0
-   gets b (1 - capture_ankle) instead of b > 0, and onto its heel (ankle above 0.15 rad) while
-   beyond < 0 likewise for b < 0: past the toes the ankles can move the centre of pressure no
-   further, and plantarflexing more only rolls the foot onto its toes and shortens the base of
-   support (about 6 cm at 0.6 rad). ``--no-ankle-drive``
+   in the plane, rooty + hip + knee + ankle; kernel.beyond_feet), and beyond = 0 in any other
+   rhythm or stance. A support foot tilted onto its toes (its angle in the world below
+   -kernel.CAPTURE_TILT_RAD = -0.15 rad, toes down) while beyond > 0 gets b (1 - capture_ankle)
+   instead of b > 0, and one tilted onto its heel (above 0.15 rad) while beyond < 0 likewise
+   for b < 0: past the toes the ankles can move the centre of pressure no further, and
+   plantarflexing more only rolls the foot onto its toes and shortens the base of support
+   (about 6 cm at 0.6 rad). ``--no-ankle-drive``
    sets ankle_gain = 0 (the reflexes stay).
 4. Hips (torques as fractions of the motor gear, clipped to [-1, 1]):
    tau_torso = kp_t (pitch_d' - pitch) - kd_t pitch_rate, with the pitch target
