@@ -26,10 +26,10 @@ rhythm, 10, but the hop's falls after -5 N s 20 -> 22; with a threshold of 2-8 c
 response starts, 14-32: it must act while the push is still on, when the XcoM is only just
 past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's excess, 18-21 of
 40 against 21). Over tuning states 1000-1099 (x1.0, x0.7, x1.3 open loop and x1.0 with K =
-0.03) the jump passes validate in 399 of 400 with either gains, the hop in 361 and 358. capture_place 15 and capture_ankle 1
-were put to rule K (docs/JOURNAL.md, session 47), in a form that read "on its toes" from the
-ankle joint's angle; the kernel now reads the foot's tilt in the world, and --grid gives the
-same counts in every cell.
+0.03) the jump passes validate in 399 of 400 with either gains, the hop in 361 and 358.
+capture_place 15 and capture_ankle 1 were put to rule K (docs/JOURNAL.md, session 47), in a
+form that read "on its toes" from the ankle joint's angle; the kernel now reads the foot's tilt
+in the world, and --grid gives the same counts in every cell.
 """
 import argparse
 import sys

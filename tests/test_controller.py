@@ -718,6 +718,9 @@ def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, v
 
     u0, m, d = _jump_controls(CONTROL, ankle_rad, vx, False, crouch)
     ix = kernel_index(m)
+    for i in range(2):  # the case's foot: tilted past the gate, or flat
+        assert (abs(K.foot_angle(d.qpos, ix, i)) > K.CAPTURE_TILT_RAD) == (ankle_rad != 0.0
+                                                                         and not crouch)
     beyond = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
                            d.sensordata[ix[K.IX_COMVEL]])
     assert np.sign(beyond) == np.sign(vx)  # the XcoM has left the feet in every case

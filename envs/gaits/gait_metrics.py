@@ -199,6 +199,8 @@ def measure(t: np.ndarray, contact: np.ndarray, com_x: np.ndarray, fell_at: floa
 
 
 # ------------------------------------------------------------------ biomechanics
+# G and Z_FLOOR_M are also read by the compiled control kernel (envs.control.control_kernel),
+# whose numba cache does not see a change here: clear it (__pycache__) after changing them.
 G = 9.81  # m/s^2
 IN_PLACE_MPS = 0.1  # below this mean speed a gait is "in place": work per stride, not CoT
 
