@@ -22,13 +22,17 @@ is the committed gains. Each re-roll counts what rule K's third clause counts, w
 
 (The Hopf matrix and the Matsuoka walk, which rule K also names, are left out: rerolling them
 is the same experiment on other networks.) Prints each re-roll's counts and whether the clause
-holds, then each condition that did not hold in every re-roll with how often it held.
+holds, each count's null distribution (min, 5th percentile, median, max over the re-rolls
+after 0: where a limit that a rule fixes before it meets a candidate could come from), then
+each condition that did not hold in every re-roll with how often it held.
 """
 import argparse
 import json
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+
+import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from tests.test_physics import (CONDITION_IDS, CONDITIONS, PERTURBATION_IDS,  # noqa: E402
@@ -191,6 +195,15 @@ def main() -> None:
               f"{'yes' if ok else 'no'}")
     print(f"K3 holds in {n_ok} of {a.rerolls} re-rolls (re-roll 0, the committed gains, is the "
           f"baseline)")
+    print("each count: the baseline; over the null re-rolls min / 5th percentile / median / max "
+          "(a limit from the null, if a rule fixes one before it meets a candidate)")
+    counts = [clause(held[r], base)[0] for r in held if r > 0]
+    for name in base:
+        null = np.array([c[name] for c in counts])
+        label = (f"{'feedback' if name[2] else 'open loop'} {name[1]}" if isinstance(name, tuple)
+                 else name)
+        print(f"  {label:28s} {base[name]:3d}   {null.min():3d} / "
+              f"{np.percentile(null, 5):5.1f} / {np.median(null):5.1f} / {null.max():3d}")
     keys = sorted(held[0], key=str)
     print("conditions that did not hold in every re-roll (held in n of "
           f"{a.rerolls + 1}, re-roll 0 included):")
