@@ -86,9 +86,8 @@ def job(task):
         k = RECOMMENDED["ml"] if fb else 0.0
         res, *_ = transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
                              feedback=k, params=p)
-        ok = (not res["fell"] and res["before"]["physical_gait"] == a
-              and res["cycles_to_switch"] is not None and res["cycles_to_switch"] <= 4)
-        return r, ("in-family", a, b, ramp, fb), ok
+        # the transition's own verdict (no fall, A before, B settled), within 4 CPG cycles
+        return r, ("in-family", a, b, ramp, fb), res["switched"] and res["cycles_to_switch"] <= 4
     a, b = args  # cross-family: reached in one of four ways
     for ramp in (0.0, 2.0):
         for fb in (False, True):

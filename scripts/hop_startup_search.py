@@ -32,7 +32,8 @@ Score of a candidate (lower is better):
 Writes OUT/gains.json (the start file with the corner replaced, as a link of a tuning chain:
 a set_by_hand provenance entry naming this command; whoever adopts it adds why) and
 OUT/history.json (every generation's best). Session 46's two runs (--n 60 and --n 100, 10
-generations) and the rules that did not adopt them: docs/JOURNAL.md, "Session 46". About 12 minutes on 2 cores (n 100, 10 generations of 12).
+generations) and the rules that did not adopt them: docs/JOURNAL.md, "Session 46". About 12
+minutes on 2 cores (n 100, 10 generations of 12).
 """
 from __future__ import annotations
 
