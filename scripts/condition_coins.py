@@ -2,14 +2,15 @@
 matters: the chance that a rule's clause on the tests' conditions (rules J and K, journal
 sessions 46 and 47) passes a change that leaves every rate where it is.
 
-    python scripts/condition_coins.py [--rerolls 10] [--eps 1e-6] [--json FILE]
+    python scripts/condition_coins.py [--rerolls 10] [--eps 1e-6] [--gains FILE] [--json FILE]
 
 The body is chaotic: a change of the gains far below anything physical still moves every
 trajectory after a few seconds, and each single test condition is then a new draw from its own
 pass rate. Re-roll r (0 .. --rerolls) adds r x --eps rad to theta0, the placing thigh's
 target, at every corner and start-up corner (1e-6 rad moves a foot by under a micrometre); r = 0
-is the committed gains. Each re-roll counts what rule K's third clause counts, with its limits
-(K3; the baseline, where a limit is relative, is re-roll 0):
+is the committed gains (or --gains FILE, whose re-rolls are then its own null). Each re-roll
+counts what rule K's third clause counts, with its limits (K3; the baseline, where a limit is
+relative, is re-roll 0):
 
 - the 13 test conditions (tests/test_physics.py) of each preset, open loop, every criterion
   (the hop's cadence against the jump's of the same condition): >= 12 of 13 each;
@@ -45,13 +46,13 @@ PERTURBATIONS = tuple((pid, cond) for pid, cond in zip(PERTURBATION_IDS, _TEST_P
 MAX_SHIFT_RAD = 1e-4  # the largest re-roll's shift of theta0: far below anything physical
 
 
-def params_for(r: int, eps: float):
+def params_for(r: int, eps: float, gains: str | None = None):
     from dataclasses import replace
 
     from cpgbiped.envs.control import control_kernel as kernel
-    from cpgbiped.envs.control.controller import CONTROL
+    from cpgbiped.envs.control.controller import CONTROL, read_gains
 
-    p = CONTROL
+    p = read_gains(gains)[0] if gains else CONTROL
     if r == 0:
         return p
     for c in kernel.CORNERS:
@@ -72,8 +73,8 @@ def job(task):
     from cpgbiped.envs.gaits.criteria import WINDOW_S
     from cpgbiped.envs.gaits.validate import validate
 
-    r, eps, kind, args = task
-    p = params_for(r, eps)
+    r, eps, gains, kind, args = task
+    p = params_for(r, eps, gains)
     if kind == "validate":
         gait, cid, cond, fb = args
         cond = dict(cond)
@@ -99,20 +100,20 @@ def job(task):
     return r, ("cross", a, b), False
 
 
-def tasks(r: int, eps: float) -> list:
+def tasks(r: int, eps: float, gains: str | None = None) -> list:
     from cpgbiped.envs.experiments.transition import IN_FAMILY
 
     out = []
     for fb in (False, True):
-        out += [(r, eps, "validate", (g, cid, cond, fb)) for g in GAITS
+        out += [(r, eps, gains, "validate", (g, cid, cond, fb)) for g in GAITS
                 for cid, cond in zip(CONDITION_IDS, CONDITIONS)]
-    out += [(r, eps, "validate", (g, pid, cond, False)) for g in GAITS
+    out += [(r, eps, gains, "validate", (g, pid, cond, False)) for g in GAITS
             for pid, cond in PERTURBATIONS]
-    out += [(r, eps, "validate", (g, "state7", {"seed": 7}, False)) for g in GAITS]
-    out += [(r, eps, "in-family", (a, b, ramp, fb)) for a, b in sorted(IN_FAMILY)
+    out += [(r, eps, gains, "validate", (g, "state7", {"seed": 7}, False)) for g in GAITS]
+    out += [(r, eps, gains, "in-family", (a, b, ramp, fb)) for a, b in sorted(IN_FAMILY)
             for ramp in (0.0, 2.0) for fb in (False, True)]
     cross = [(a, b) for a in GAITS for b in GAITS if a != b and (a, b) not in IN_FAMILY]
-    out += [(r, eps, "cross", pair) for pair in cross]
+    out += [(r, eps, gains, "cross", pair) for pair in cross]
     return out
 
 
@@ -169,12 +170,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rerolls", type=int, default=10, choices=range(1, 101), metavar="1..100")
     ap.add_argument("--eps", type=float, default=1e-6, help="rad per re-roll (default 1e-6)")
+    ap.add_argument("--gains", default=None, metavar="FILE",
+                    help="re-roll this gains file instead of the committed one")
     ap.add_argument("--json", default=None, help="write every single condition's outcomes")
     a = ap.parse_args()
     if not 0.0 < a.eps * a.rerolls <= MAX_SHIFT_RAD:
         ap.error(f"--eps > 0 and --rerolls x --eps at most {MAX_SHIFT_RAD:g} rad: far below "
                  "anything physical")
-    all_tasks = [t for r in range(a.rerolls + 1) for t in tasks(r, a.eps)]
+    all_tasks = [t for r in range(a.rerolls + 1) for t in tasks(r, a.eps, a.gains)]
     results = {r: {} for r in range(a.rerolls + 1)}
     with ProcessPoolExecutor(2) as ex:
         for r, key, out in ex.map(job, all_tasks, chunksize=4):

@@ -800,7 +800,7 @@ def test_rule_rates_refuses_the_tuning_and_test_states(monkeypatch, capsys):
         assert "overlap" in capsys.readouterr().err
 
 
-def test_condition_coins_counts_rule_k_s_clause_with_its_limits():
+def test_condition_coins_counts_rule_k_s_clause_with_its_limits(tmp_path):
     """scripts/condition_coins.py: re-roll r moves theta0 by r x eps at every corner and start-up
     corner and nothing else (r = 0: the committed gains); the clause counts each kind of
     single condition and applies rule K3's limits (open loop >= 12 of 13 each, with feedback
@@ -810,6 +810,14 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits():
     README's status: journal, session 47)."""
     cc = _script("condition_coins")
     assert cc.params_for(0, 1e-6) is CONTROL
+    # --gains: the re-rolls start from that file's gains (the committed file with one gain moved)
+    d = json.loads(GAINS_FILE.read_text())
+    d["corners"]["synchronous"]["capture_place"] = 15.0
+    other = tmp_path / "gains.json"
+    other.write_text(json.dumps(d))
+    assert cc.params_for(0, 1e-6, str(other)).corner("synchronous").capture_place == 15.0
+    assert cc.params_for(2, 1e-6, str(other)).corner("synchronous").theta0 == pytest.approx(
+        CONTROL.corner("synchronous").theta0 + 2e-6, abs=1e-15)
     p = cc.params_for(3, 1e-6)
     for name in CORNER_OF.values():
         assert p.corner(name).theta0 == pytest.approx(CONTROL.corner(name).theta0 + 3e-6,
