@@ -29,7 +29,9 @@ past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's exc
 0.03) the jump passes validate in 399 of 400 with either gains, the hop in 361 and 358.
 capture_place 15 and capture_ankle 1 were put to rule K (docs/JOURNAL.md, session 47), in a
 form that read "on its toes" from the ankle joint's angle; the kernel now reads the foot's tilt
-in the world, and --grid gives the same counts in every cell.
+in the world, and --grid gives the same counts in every cell. Put to rule L (session 48) in
+that form: not adopted. --grid holds its pushes 0.2 s; as a one-tick blow the withholding
+costs falls (tuning states 1000-1059: 9 -> 12 at 15 / 1, 35 with capture_ankle 1 alone).
 """
 import argparse
 import sys
@@ -39,7 +41,9 @@ PLACE, ANKLE = 15.0, 1.0  # rad/m, share: the jump's corner (synchronous)
 GRID = ((0.0, 0.0), (10.0, 1.0), (15.0, 1.0), (20.0, 1.0), (30.0, 1.0), (10.0, 0.0), (0.0, 1.0))
 CONDITIONS = ((5.0, 1.0), (-5.0, 1.0), (0.0, 1.0), (0.0, 0.5), (0.0, 2.0))  # (N s at 6 s, friction)
 RULE = ("rule K (docs/JOURNAL.md, session 47): not met (in-family transitions 7 -> 5 of 16, "
-        "cross-family 6 -> 3 of 8), not adopted")
+        "cross-family 6 -> 3 of 8); rule L (session 48): not met (the jump's forward pushes "
+        "from unused states 68 -> 67 of 100: held 28 -> 39, one-tick blows 40 -> 28; the hop "
+        "from state 7 kept in 8 of 21 re-rolls); not adopted")
 
 
 def _fell(job):
