@@ -3,6 +3,7 @@ matters: the chance that a rule's clause on the tests' conditions (rules J and K
 sessions 46 and 47) passes a change that leaves every rate where it is.
 
     python scripts/condition_coins.py [--rerolls 10] [--eps 1e-6] [--gains FILE] [--json FILE]
+    python scripts/condition_coins.py --compare BASE.json CANDIDATE.json
 
 The body is chaotic: a change of the gains far below anything physical still moves every
 trajectory after a few seconds, and each single test condition is then a new draw from its own
@@ -26,6 +27,11 @@ is the same experiment on other networks.) Prints each re-roll's counts and whet
 holds, each count's null distribution (min, 5th percentile, median, max over the re-rolls
 after 0: where a limit that a rule fixes before it meets a candidate could come from), then
 each condition that did not hold in every re-roll with how often it held.
+
+--compare judges a candidate's tests' conditions as distributions (rule L, journal session
+48): two --json files, the baseline's and the candidate's re-rolls, each count's mean over
+each file's draws, and whether the candidate's is lower by more than two standard errors of
+the difference.
 """
 import argparse
 import json
@@ -166,14 +172,63 @@ def clause(held: dict, base: dict | None) -> tuple[dict, bool]:
     return n, ok
 
 
+def label(name) -> str:
+    """A count's printed name: ("conditions", "walk", True) -> "feedback walk"."""
+    return (f"{'feedback' if name[2] else 'open loop'} {name[1]}" if isinstance(name, tuple)
+            else name)
+
+
+def compare(base: list[dict], cand: list[dict]) -> list[tuple]:
+    """Each count's mean over the baseline's draws and over the candidate's, their difference
+    and two standard errors of it, sqrt(s_b^2 / n_b + s_c^2 / n_c) (sample variances), and
+    whether the candidate's is lower by more than that (for a count that varies in neither:
+    lower at all). base, cand: one {label: count} per draw. -> (label, mean_b, mean_c,
+    difference, 2 se, lower)."""
+    rows = []
+    for name in base[0]:
+        b = np.array([d[name] for d in base], float)
+        c = np.array([d[name] for d in cand], float)
+        two_se = 2.0 * float(np.sqrt(b.var(ddof=1) / len(b) + c.var(ddof=1) / len(c)))
+        diff = float(c.mean() - b.mean())
+        rows.append((name, float(b.mean()), float(c.mean()), diff, two_se,
+                     diff < -two_se if two_se > 0 else diff < 0))
+    return rows
+
+
+def _counts_of(path: str) -> list[dict]:
+    d = json.loads(Path(path).read_text())
+    if "counts" not in d:
+        raise SystemExit(f"condition_coins: error: {path} has no counts (written before "
+                         "--json wrote them)")
+    return [d["counts"][r] for r in sorted(d["counts"], key=int)]
+
+
+def print_compare(base_path: str, cand_path: str) -> None:
+    base, cand = _counts_of(base_path), _counts_of(cand_path)
+    print(f"each count's mean over {len(base)} draws ({base_path}) and {len(cand)} "
+          f"({cand_path}): difference, 2 standard errors")
+    rows = compare(base, cand)
+    for name, mb, mc, d, two_se, lower in rows:
+        print(f"  {name:22s} {mb:6.2f} -> {mc:6.2f}  {d:+6.2f}  2 se {two_se:5.2f}"
+              + ("  LOWER" if lower else ""))
+    print("no count lower by more than 2 se" if not any(r[-1] for r in rows)
+          else "lower: " + ", ".join(r[0] for r in rows if r[-1]))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rerolls", type=int, default=10, choices=range(1, 101), metavar="1..100")
     ap.add_argument("--eps", type=float, default=1e-6, help="rad per re-roll (default 1e-6)")
     ap.add_argument("--gains", default=None, metavar="FILE",
                     help="re-roll this gains file instead of the committed one")
-    ap.add_argument("--json", default=None, help="write every single condition's outcomes")
+    ap.add_argument("--json", default=None,
+                    help="write every single condition's outcomes and each re-roll's counts")
+    ap.add_argument("--compare", nargs=2, metavar=("BASE.json", "CANDIDATE.json"),
+                    help="run nothing: compare two --json files' counts, draw for draw")
     a = ap.parse_args()
+    if a.compare:
+        print_compare(*a.compare)
+        return
     if not 0.0 < a.eps * a.rerolls <= MAX_SHIFT_RAD:
         ap.error(f"--eps > 0 and --rerolls x --eps at most {MAX_SHIFT_RAD:g} rad: far below "
                  "anything physical")
@@ -202,9 +257,7 @@ def main() -> None:
     counts = [clause(held[r], base)[0] for r in held if r > 0]
     for name in base:
         null = np.array([c[name] for c in counts])
-        label = (f"{'feedback' if name[2] else 'open loop'} {name[1]}" if isinstance(name, tuple)
-                 else name)
-        print(f"  {label:28s} {base[name]:3d}   {null.min():3d} / "
+        print(f"  {label(name):28s} {base[name]:3d}   {null.min():3d} / "
               f"{np.percentile(null, 5):5.1f} / {np.median(null):5.1f} / {null.max():3d}")
     keys = sorted(held[0], key=str)
     print("conditions that did not hold in every re-roll (held in n of "
@@ -214,9 +267,12 @@ def main() -> None:
         if c < len(held):
             print(f"  {' '.join(str(x) for x in k)}: {c}")
     if a.json:
-        Path(a.json).write_text(json.dumps({str(r): {" ".join(map(str, k)): bool(v)
-                                                     for k, v in held[r].items()}
-                                            for r in held}, indent=1))
+        Path(a.json).write_text(json.dumps({
+            "gains": a.gains, "eps": a.eps,
+            "held": {str(r): {" ".join(map(str, k)): bool(v) for k, v in held[r].items()}
+                     for r in held},
+            "counts": {str(r): {label(k): v for k, v in clause(held[r], base)[0].items()}
+                       for r in held}}, indent=1))
 
 
 if __name__ == "__main__":

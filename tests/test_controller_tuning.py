@@ -850,3 +850,29 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits(tmp_path):
     for bad in (dict(ol_fail=2), dict(fb_fail=2), dict(pert=14), dict(fam=5), dict(cross=3),
                 dict(jump_stands=False)):
         assert not cc.clause(held(**bad), base)[1], bad
+
+
+def test_condition_coins_compare_flags_a_count_lower_by_more_than_two_standard_errors(tmp_path):
+    """scripts/condition_coins.py --compare: each count's mean over each file's draws, the
+    difference's two standard errors sqrt(s_b^2/n_b + s_c^2/n_c), and "lower" only beyond them
+    (a count that varies in neither: lower at all). Hand-computed cases: a count 4,4,4,3 ->
+    3,3,3,3 has means 3.75 and 3, 2 se = 2 sqrt(0.25/4) = 0.5: lower; 5,6,5,6 -> 5,5,6,5 has
+    means 5.5 and 5.25, 2 se = 2 sqrt(1/3/4 + 0.25/4) = 0.764: not lower; 13 -> 12 in every draw:
+    lower; 13 -> 13: not."""
+    cc = _script("condition_coins")
+    base = [{"a": 4, "b": 5, "c": 13, "d": 13}, {"a": 4, "b": 6, "c": 13, "d": 13},
+            {"a": 4, "b": 5, "c": 13, "d": 13}, {"a": 3, "b": 6, "c": 13, "d": 13}]
+    cand = [{"a": 3, "b": 5, "c": 12, "d": 13}, {"a": 3, "b": 5, "c": 12, "d": 13},
+            {"a": 3, "b": 6, "c": 12, "d": 13}, {"a": 3, "b": 5, "c": 12, "d": 13}]
+    rows = {r[0]: r[1:] for r in cc.compare(base, cand)}
+    assert rows["a"][:4] == pytest.approx((3.75, 3.0, -0.75, 0.5)) and rows["a"][4]
+    assert rows["b"][:4] == pytest.approx((5.5, 5.25, -0.25, 0.7638), abs=1e-4)
+    assert not rows["b"][4]
+    assert rows["c"][4] and not rows["d"][4]
+    for name, draws in (("base.json", base), ("cand.json", cand)):
+        (tmp_path / name).write_text(json.dumps({"counts": {str(r): d
+                                                            for r, d in enumerate(draws)}}))
+    assert cc._counts_of(str(tmp_path / "cand.json")) == cand
+    (tmp_path / "old.json").write_text(json.dumps({"0": {"validate walk table3 False": True}}))
+    with pytest.raises(SystemExit, match="no counts"):
+        cc._counts_of(str(tmp_path / "old.json"))
