@@ -806,8 +806,8 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits(tmp_path):
     single condition and applies rule K3's limits (open loop >= 12 of 13 each, with feedback
     no more than one below the baseline, the jump standing with feedback, perturbations >= 15
     of 16, matrices 4/4, in-family >= 6, cross-family >= 4). Synthetic outcomes, counted by
-    hand (outcomes(), which turns rollouts into them, is checked by re-roll 0 reproducing the
-    README's status: journal, session 47)."""
+    hand (outcomes(), which turns rollouts into them, has its own test below, and re-roll 0
+    reproduces the README's status: journal, session 47)."""
     cc = _script("condition_coins")
     assert cc.params_for(0, 1e-6) is CONTROL
     # --gains: the re-rolls start from that file's gains (the committed file with one gain moved)
@@ -876,3 +876,60 @@ def test_condition_coins_compare_flags_a_count_lower_by_more_than_two_standard_e
     (tmp_path / "old.json").write_text(json.dumps({"0": {"validate walk table3 False": True}}))
     with pytest.raises(SystemExit, match="no counts"):
         cc._counts_of(str(tmp_path / "old.json"))
+
+
+def test_condition_coins_outcomes_turn_rollouts_into_the_clause_s_single_conditions(monkeypatch):
+    """scripts/condition_coins.py outcomes(): a perturbation or the state-7 run is kept when it
+    stands and its contacts name its own gait (criteria not applied); a test condition holds
+    when the preset's criteria find no failure, the hop judged against the jump's summary of
+    the same condition and loop; the matrix's Table 3 row comes from the open-loop Table 3
+    rollout (named, standing); "the jump stands with feedback" looks only at the 13 conditions
+    with feedback. Criteria replaced by stand-ins that fail a summary marked "bad", and that
+    record which reference summary the hop was given."""
+    import cpgbiped.envs.gaits.criteria as criteria
+
+    cc = _script("condition_coins")
+    seen = []
+
+    class Stub:
+        def __init__(self, ref):
+            self.cadence_above = ref
+
+        def failures(self, s, others):
+            seen.append((s["id"], {k: v["id"] for k, v in others.items()}))
+            return ["bad"] if s.get("bad") else []
+
+    monkeypatch.setattr(criteria, "CRITERIA", {"walk": Stub(None), "run": Stub(None),
+                                               "jump": Stub(None), "hop": Stub("jump")})
+    res = {}
+    for g in cc.GAITS:
+        for fb in (False, True):
+            for cid in ("table3", "seed10"):
+                res[("validate", g, cid, fb)] = {"id": f"{g}-{cid}-{fb}", "fell": False,
+                                                 "physical_gait": g}
+        res[("validate", g, "push+5", False)] = {"id": "p", "fell": False, "physical_gait": g,
+                                                 "bad": True}
+        res[("validate", g, "state7", False)] = {"id": "s7", "fell": False,
+                                                 "physical_gait": g}
+    res[("validate", "walk", "seed10", True)]["bad"] = True       # a criterion fails
+    res[("validate", "run", "table3", False)]["physical_gait"] = "walk"  # matrix row: misnamed
+    res[("validate", "jump", "push+5", False)]["fell"] = True     # a perturbation: a fall
+    res[("validate", "hop", "state7", False)]["physical_gait"] = "jump"
+    res[("validate", "jump", "state7", False)]["fell"] = True     # not a feedback condition
+    res[("in-family", "walk", "run", 0.0, False)] = True
+    res[("cross", "walk", "hop")] = False
+    held = cc.outcomes(res)
+    assert held[("validate", "walk", "seed10", True)] is False
+    assert held[("validate", "walk", "seed10", False)] is True
+    assert held[("validate", "walk", "push+5", False)] is True  # criteria not applied to it
+    assert held[("validate", "jump", "push+5", False)] is False
+    assert held[("validate", "hop", "state7", False)] is False
+    assert held[("matrix", "run")] is False and held[("matrix", "walk")] is True
+    assert ("matrix", "walk") in held and sum(k[0] == "matrix" for k in held) == 4
+    assert held[("jump no fall with feedback",)] is True
+    assert held[("in-family", "walk", "run", 0.0, False)] is True
+    assert held[("cross", "walk", "hop")] is False
+    assert ("hop-seed10-True", {"jump": "jump-seed10-True"}) in seen
+    assert ("hop-table3-False", {"jump": "jump-table3-False"}) in seen
+    res[("validate", "jump", "seed10", True)]["fell"] = True
+    assert cc.outcomes(res)[("jump no fall with feedback",)] is False
