@@ -195,18 +195,45 @@ def compare(base: list[dict], cand: list[dict]) -> list[tuple]:
     return rows
 
 
-def _counts_of(path: str) -> list[dict]:
+def to_json(held: dict, gains: str | None, eps: float) -> dict:
+    """What --json writes: every single condition's outcome and each re-roll's counts (by
+    label; "jump stands with feedback" 1 or 0), re-roll 0 the baseline of clause()'s limits."""
+    base, _ = clause(held[0], None)
+
+    def counts(h):
+        n = {label(k): v for k, v in clause(h, base)[0].items()}
+        n["jump stands with feedback"] = int(h[("jump no fall with feedback",)])
+        return n
+
+    return {"gains": gains, "eps": eps,
+            "held": {str(r): {" ".join(map(str, k)): bool(v) for k, v in held[r].items()}
+                     for r in held},
+            "counts": {str(r): counts(held[r]) for r in held}}
+
+
+def _counts_of(path: str) -> tuple[list[dict], dict]:
+    """A --json file's counts, one dict per draw, and the file itself; ValueError without
+    counts, with fewer than two draws, or with draws that do not count the same things."""
     d = json.loads(Path(path).read_text())
     if "counts" not in d:
-        raise SystemExit(f"condition_coins: error: {path} has no counts (written before "
-                         "--json wrote them)")
-    return [d["counts"][r] for r in sorted(d["counts"], key=int)]
+        raise ValueError(f"{path} has no counts (written before --json wrote them)")
+    draws = list(d["counts"].values())
+    if len(draws) < 2:
+        raise ValueError(f"{path} has {len(draws)} draw; a standard error needs at least 2")
+    if any(set(x) != set(draws[0]) for x in draws):
+        raise ValueError(f"{path}'s draws do not count the same things")
+    return draws, d
 
 
 def print_compare(base_path: str, cand_path: str) -> None:
-    base, cand = _counts_of(base_path), _counts_of(cand_path)
-    print(f"each count's mean over {len(base)} draws ({base_path}) and {len(cand)} "
-          f"({cand_path}): difference, 2 standard errors")
+    (base, bd), (cand, cd) = _counts_of(base_path), _counts_of(cand_path)
+    if set(base[0]) != set(cand[0]):
+        raise ValueError("the two files do not count the same things")
+    print(f"each count's mean over {len(base)} draws ({base_path}, gains {bd.get('gains')}, "
+          f"eps {bd.get('eps')}) and {len(cand)} ({cand_path}, gains {cd.get('gains')}, eps "
+          f"{cd.get('eps')}): difference, 2 standard errors")
+    if bd.get("eps") != cd.get("eps"):
+        print("warning: the two files re-rolled by different eps")
     rows = compare(base, cand)
     for name, mb, mc, d, two_se, lower in rows:
         print(f"  {name:22s} {mb:6.2f} -> {mc:6.2f}  {d:+6.2f}  2 se {two_se:5.2f}"
@@ -224,10 +251,13 @@ def main() -> None:
     ap.add_argument("--json", default=None,
                     help="write every single condition's outcomes and each re-roll's counts")
     ap.add_argument("--compare", nargs=2, metavar=("BASE.json", "CANDIDATE.json"),
-                    help="run nothing: compare two --json files' counts, draw for draw")
+                    help="run nothing: compare two --json files' counts over their draws")
     a = ap.parse_args()
     if a.compare:
-        print_compare(*a.compare)
+        try:
+            print_compare(*a.compare)
+        except (OSError, ValueError) as e:  # json's decode error is a ValueError
+            ap.exit(2, f"condition_coins: error: {e}\n")
         return
     if not 0.0 < a.eps * a.rerolls <= MAX_SHIFT_RAD:
         ap.error(f"--eps > 0 and --rerolls x --eps at most {MAX_SHIFT_RAD:g} rad: far below "
@@ -267,12 +297,7 @@ def main() -> None:
         if c < len(held):
             print(f"  {' '.join(str(x) for x in k)}: {c}")
     if a.json:
-        Path(a.json).write_text(json.dumps({
-            "gains": a.gains, "eps": a.eps,
-            "held": {str(r): {" ".join(map(str, k)): bool(v) for k, v in held[r].items()}
-                     for r in held},
-            "counts": {str(r): {label(k): v for k, v in clause(held[r], base)[0].items()}
-                       for r in held}}, indent=1))
+        Path(a.json).write_text(json.dumps(to_json(held, a.gains, a.eps), indent=1))
 
 
 if __name__ == "__main__":

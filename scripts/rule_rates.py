@@ -142,8 +142,9 @@ def check_bank(ap: argparse.ArgumentParser, first: int, n: int) -> None:
         ap.error("the states overlap the tests' (10-19) or the tuning's (1000-1099)")
     used = [(lo, hi) for lo, hi in USED_BANKS if first <= hi and first + n - 1 >= lo]
     if used:
-        print("note: CPG seeds " + ", ".join(f"{lo}-{hi}" for lo, hi in used) + " were used by "
-              "an earlier rule or census: fine for re-counting it, not for a new rule",
+        print("note: CPG seeds " + ", ".join(f"{lo}-{hi}" for lo, hi in used) + " are listed "
+              "as used (by an earlier rule or census, or by the rule being measured, which "
+              "lists its bank when it is declared): fine for that rule, not for a new one",
               file=sys.stderr)
 
 

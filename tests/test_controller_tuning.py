@@ -2,6 +2,7 @@
 say, a small run writes a gains file the controller loads, an interrupted run resumes to the
 identical result, the same seed gives the same result, and the tuning conditions never meet
 the conditions the tests report."""
+import functools
 import json
 import pickle
 
@@ -800,6 +801,27 @@ def test_rule_rates_refuses_the_tuning_and_test_states(monkeypatch, capsys):
         assert "overlap" in capsys.readouterr().err
 
 
+def _coins_held(cc, ol_fail=0, fb_fail=0, pert=16, fam=7, cross=6, jump_stands=True):
+    """Synthetic single conditions of condition_coins: the first ol_fail (fb_fail) of each
+    preset's 13 conditions open loop (with feedback) fail, pert of the 16 perturbations hold,
+    fam of 16 in-family ways, cross of 8 pairs."""
+    h = {}
+    for g in cc.GAITS:
+        for fb, fails in ((False, ol_fail), (True, fb_fail)):
+            for k in range(13):
+                h[("validate", g, f"c{k}", fb)] = k >= fails
+        for k, (pid, _) in enumerate(cc.PERTURBATIONS):
+            h[("validate", g, pid, False)] = 4 * cc.GAITS.index(g) + k < pert
+        h[("validate", g, "state7", False)] = True
+        h[("matrix", g)] = True
+    for k in range(16):
+        h[("in-family", k)] = k < fam
+    for k in range(8):
+        h[("cross", k)] = k < cross
+    h[("jump no fall with feedback",)] = jump_stands
+    return h
+
+
 def test_condition_coins_counts_rule_k_s_clause_with_its_limits(tmp_path):
     """scripts/condition_coins.py: re-roll r moves theta0 by r x eps at every corner and start-up
     corner and nothing else (r = 0: the committed gains); the clause counts each kind of
@@ -816,8 +838,9 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits(tmp_path):
     other = tmp_path / "gains.json"
     other.write_text(json.dumps(d))
     assert cc.params_for(0, 1e-6, str(other)).corner("synchronous").capture_place == 15.0
-    assert cc.params_for(2, 1e-6, str(other)).corner("synchronous").theta0 == pytest.approx(
-        CONTROL.corner("synchronous").theta0 + 2e-6, abs=1e-15)
+    p2 = cc.params_for(2, 1e-6, str(other)).corner("synchronous")
+    assert p2.capture_place == 15.0
+    assert p2.theta0 == pytest.approx(CONTROL.corner("synchronous").theta0 + 2e-6, abs=1e-15)
     p = cc.params_for(3, 1e-6)
     for name in CORNER_OF.values():
         assert p.corner(name).theta0 == pytest.approx(CONTROL.corner(name).theta0 + 3e-6,
@@ -826,23 +849,7 @@ def test_condition_coins_counts_rule_k_s_clause_with_its_limits(tmp_path):
     assert all(a.theta0 == pytest.approx(b.theta0 + 3e-6, abs=1e-15)
                for a, b in zip(p.startup, CONTROL.startup))
 
-    def held(ol_fail=0, fb_fail=0, pert=16, fam=7, cross=6, jump_stands=True):
-        h = {}
-        for g in cc.GAITS:
-            for fb, fails in ((False, ol_fail), (True, fb_fail)):
-                for k in range(13):
-                    h[("validate", g, f"c{k}", fb)] = k >= fails
-            for k, (pid, _) in enumerate(cc.PERTURBATIONS):
-                h[("validate", g, pid, False)] = 4 * cc.GAITS.index(g) + k < pert
-            h[("validate", g, "state7", False)] = True
-            h[("matrix", g)] = True
-        for k in range(16):
-            h[("in-family", k)] = k < fam
-        for k in range(8):
-            h[("cross", k)] = k < cross
-        h[("jump no fall with feedback",)] = jump_stands
-        return h
-
+    held = functools.partial(_coins_held, cc)
     base, ok = cc.clause(held(), None)
     assert ok and base["perturbations"] == 16 and base["in-family"] == 7 and base["cross"] == 6
     assert base[("conditions", "hop", True)] == 13
@@ -869,13 +876,24 @@ def test_condition_coins_compare_flags_a_count_lower_by_more_than_two_standard_e
     assert rows["b"][:4] == pytest.approx((5.5, 5.25, -0.25, 0.7638), abs=1e-4)
     assert not rows["b"][4]
     assert rows["c"][4] and not rows["d"][4]
-    for name, draws in (("base.json", base), ("cand.json", cand)):
-        (tmp_path / name).write_text(json.dumps({"counts": {str(r): d
-                                                            for r, d in enumerate(draws)}}))
-    assert cc._counts_of(str(tmp_path / "cand.json")) == cand
-    (tmp_path / "old.json").write_text(json.dumps({"0": {"validate walk table3 False": True}}))
-    with pytest.raises(SystemExit, match="no counts"):
-        cc._counts_of(str(tmp_path / "old.json"))
+    # what --json writes is what --compare reads: counts by label, the jump's stand as 1 / 0
+    held = {0: _coins_held(cc), 1: _coins_held(cc, pert=14, jump_stands=False),
+            2: _coins_held(cc, fam=5)}
+    path = tmp_path / "coins.json"
+    path.write_text(json.dumps(cc.to_json(held, "g.json", 1e-6)))
+    draws, d = cc._counts_of(str(path))
+    assert d["gains"] == "g.json" and d["eps"] == 1e-6
+    assert [x["perturbations"] for x in draws] == [16, 14, 16]
+    assert [x["in-family"] for x in draws] == [7, 7, 5]
+    assert [x["jump stands with feedback"] for x in draws] == [1, 0, 1]
+    assert [x["feedback hop"] for x in draws] == [13, 13, 13]
+    refused = {"old.json": ({"0": {"validate walk table3 False": True}}, "no counts"),
+               "one.json": ({"counts": {"0": {"a": 1}}}, "at least 2"),
+               "mixed.json": ({"counts": {"0": {"a": 1}, "1": {"b": 1}}}, "same things")}
+    for name, (content, msg) in refused.items():
+        (tmp_path / name).write_text(json.dumps(content))
+        with pytest.raises(ValueError, match=msg):
+            cc._counts_of(str(tmp_path / name))
 
 
 def test_condition_coins_outcomes_turn_rollouts_into_the_clause_s_single_conditions(monkeypatch):
@@ -925,7 +943,7 @@ def test_condition_coins_outcomes_turn_rollouts_into_the_clause_s_single_conditi
     assert held[("validate", "jump", "push+5", False)] is False
     assert held[("validate", "hop", "state7", False)] is False
     assert held[("matrix", "run")] is False and held[("matrix", "walk")] is True
-    assert ("matrix", "walk") in held and sum(k[0] == "matrix" for k in held) == 4
+    assert sum(k[0] == "matrix" for k in held) == 4
     assert held[("jump no fall with feedback",)] is True
     assert held[("in-family", "walk", "run", 0.0, False)] is True
     assert held[("cross", "walk", "hop")] is False
