@@ -2,7 +2,7 @@
 tuning CPG states, and set by hand as one link of a tuning chain (set_by_hand, with what was
 set and why), from START's gains into OUT/cr.
 
-    python scripts/capture_response.py --grid [--n 60]     # the measurements that chose it
+    python scripts/capture_response.py --grid [--n 60] [--gait jump|hop] [--cells 15,1;30,0]
     python scripts/capture_response.py START.json OUT       # the link (scripts/tune_gains.sh)
 
 Why: pushed forwards by 5 N s at 6 s, the jump falls from about half of all CPG states; the
@@ -39,7 +39,10 @@ from concurrent.futures import ProcessPoolExecutor
 
 PLACE, ANKLE = 15.0, 1.0  # rad/m, share: the jump's corner (synchronous)
 GRID = ((0.0, 0.0), (10.0, 1.0), (15.0, 1.0), (20.0, 1.0), (30.0, 1.0), (10.0, 0.0), (0.0, 1.0))
-CONDITIONS = ((5.0, 1.0), (-5.0, 1.0), (0.0, 1.0), (0.0, 0.5), (0.0, 2.0))  # (N s at 6 s, friction)
+# (N s at 6 s, held s, friction): the first five are session 47's columns; the one-tick blows
+# (a 4 ms control tick) were added in session 48, after rule L found them (docs/JOURNAL.md)
+CONDITIONS = ((5.0, 0.2, 1.0), (-5.0, 0.2, 1.0), (0.0, 0.0, 1.0), (0.0, 0.0, 0.5),
+              (0.0, 0.0, 2.0), (5.0, 0.004, 1.0), (-5.0, 0.004, 1.0))
 RULE = ("rule K (docs/JOURNAL.md, session 47): not met (in-family transitions 7 -> 5 of 16, "
         "cross-family 6 -> 3 of 8); rule L (session 48): not met (the jump's forward pushes "
         "from unused states 68 -> 67 of 100: held 28 -> 39, one-tick blows 40 -> 28; the hop "
@@ -47,27 +50,38 @@ RULE = ("rule K (docs/JOURNAL.md, session 47): not met (in-family transitions 7 
 
 
 def _fell(job):
-    gait, seed, impulse, friction, place, ankle = job
+    gait, seed, impulse, held_s, friction, place, ankle = job
     from cpgbiped.cpg.network import build
     from cpgbiped.envs.control.controller import CONTROL
     from cpgbiped.envs.simulation.rollout import rollout
 
     p = CONTROL.with_corner("synchronous", capture_place=place, capture_ankle=ankle)
-    push = (6.0, impulse, 0.2) if impulse else None
+    push = (6.0, impulse, held_s) if impulse else None
     return rollout(build("ml", gait, seed=seed), 14.0, p, push=push, friction_scale=friction,
                    poses=False).fell_at is not None
 
 
-def grid(gait: str, n: int) -> None:
+def grid(gait: str, n: int, cells=GRID) -> None:
     print(f"{gait}, tuning CPG states 1000-{999 + n}, 14 s; falls after +5 / -5 N s held 0.2 s "
-          f"at 6 s, unpushed, friction x0.5, x2.0")
+          f"at 6 s, unpushed, friction x0.5, x2.0, +5 / -5 N s as one-tick blows at 6 s")
     with ProcessPoolExecutor(2) as ex:
-        for place, ankle in GRID:
-            falls = [sum(ex.map(_fell, [(gait, s, imp, fr, place, ankle)
+        for place, ankle in cells:
+            falls = [sum(ex.map(_fell, [(gait, s, imp, held, fr, place, ankle)
                                         for s in range(1000, 1000 + n)]))
-                     for imp, fr in CONDITIONS]
+                     for imp, held, fr in CONDITIONS]
             print(f"capture_place {place:4g} capture_ankle {ankle:g}: "
                   + " / ".join(str(f) for f in falls) + f" of {n}", flush=True)
+
+
+def cells_arg(text: str) -> tuple:
+    """--cells "15,1;30,0" -> ((15.0, 1.0), (30.0, 0.0)); argparse's error for anything else."""
+    try:
+        cells = tuple(tuple(float(x) for x in c.split(",")) for c in text.split(";"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not numbers: {text!r}") from None
+    if not all(len(c) == 2 and c[0] >= 0.0 and 0.0 <= c[1] <= 1.0 for c in cells):
+        raise argparse.ArgumentTypeError(f"pairs P,A with P >= 0 and A in 0-1: {text!r}")
+    return cells
 
 
 def main() -> None:
@@ -76,8 +90,11 @@ def main() -> None:
         ap.add_argument("--grid", action="store_true")
         ap.add_argument("--gait", default="jump", choices=("jump", "hop"))
         ap.add_argument("--n", type=int, default=60, choices=range(1, 101), metavar="1..100")
+        ap.add_argument("--cells", type=cells_arg, default=GRID, metavar="P,A;P,A;...",
+                        help="capture_place (rad/m, >= 0) and capture_ankle (0-1) pairs "
+                             "(default: session 47's grid)")
         a = ap.parse_args()
-        grid(a.gait, a.n)
+        grid(a.gait, a.n, a.cells)
         return
     from cpgbiped.envs.search.controller_tuning import hand_set_link
 
