@@ -21,7 +21,8 @@ Chosen on tuning CPG states 1000-1059 only (--grid; 14 s rollouts, falls of 60 a
 -5 N s held 0.2 s at 6 s, unpushed, friction x0.5, x2.0): the committed gains 32 / 12 / 0 / 3 /
 1; the jump's corner with capture_place 10, 15, 20, 30 rad/m and capture_ankle 1: 13, 10, 15,
 11 after +5 N s, the others within one of the committed; capture_place 10 alone 30,
-capture_ankle 1 alone 27 (session files, out/s47: the two as shared gains, in every corner's
+capture_ankle 1 alone 27 (these in the joint-angle form below; the foot-angle form gives 17,
+15, 15, 12 and 23: session 48's grid, docs/JOURNAL.md) (session files, out/s47: the two as shared gains, in every corner's
 rhythm, 10, but the hop's falls after -5 N s 20 -> 22; with a threshold of 2-8 cm before the
 response starts, 14-32: it must act while the push is still on, when the XcoM is only just
 past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's excess, 18-21 of
@@ -29,8 +30,8 @@ past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's exc
 0.03) the jump passes validate in 399 of 400 with either gains, the hop in 361 and 358.
 capture_place 15 and capture_ankle 1 were put to rule K (docs/JOURNAL.md, session 47), in a
 form that read "on its toes" from the ankle joint's angle; the kernel now reads the foot's tilt
-in the world, and --grid gives the same counts in every cell. Put to rule L (session 48) in
-that form: not adopted. --grid holds its pushes 0.2 s; as a one-tick blow the withholding
+in the world (session 47 thought --grid gave the same counts in every cell; it does not, see
+above). Put to rule L (session 48) in that form: not adopted. --grid holds its pushes 0.2 s; as a one-tick blow the withholding
 costs falls (tuning states 1000-1059: 9 -> 12 at 15 / 1, 35 with capture_ankle 1 alone).
 """
 import argparse
