@@ -2,7 +2,7 @@
 tuning CPG states, and set by hand as one link of a tuning chain (set_by_hand, with what was
 set and why), from START's gains into OUT/cr.
 
-    python scripts/capture_response.py --grid [--n 60] [--gait jump|hop] [--cells 15,1;30,0]
+    python scripts/capture_response.py --grid [--n 60] [--gait jump|hop] [--cells "15,1;30,0"]
     python scripts/capture_response.py START.json OUT       # the link (scripts/tune_gains.sh)
 
 Why: pushed forwards by 5 N s at 6 s, the jump falls from about half of all CPG states; the
@@ -21,8 +21,9 @@ Chosen on tuning CPG states 1000-1059 only (--grid; 14 s rollouts, falls of 60 a
 -5 N s held 0.2 s at 6 s, unpushed, friction x0.5, x2.0): the committed gains 32 / 12 / 0 / 3 /
 1; the jump's corner with capture_place 10, 15, 20, 30 rad/m and capture_ankle 1: 13, 10, 15,
 11 after +5 N s, the others within one of the committed; capture_place 10 alone 30,
-capture_ankle 1 alone 27 (these in the joint-angle form below; the foot-angle form gives 17,
-15, 15, 12 and 23: session 48's grid, docs/JOURNAL.md) (session files, out/s47: the two as shared gains, in every corner's
+capture_ankle 1 alone 27. Those were the joint-angle form's counts (below). The foot-angle
+form gives 17, 15, 15, 12 and 23 after +5 N s, and 9-10 after -5 N s: session 48's grid in
+docs/JOURNAL.md. (Session files, out/s47: the two as shared gains, in every corner's
 rhythm, 10, but the hop's falls after -5 N s 20 -> 22; with a threshold of 2-8 cm before the
 response starts, 14-32: it must act while the push is still on, when the XcoM is only just
 past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's excess, 18-21 of
@@ -30,20 +31,23 @@ past the toes; a hip strategy, the trunk's pitch target raised by the XcoM's exc
 0.03) the jump passes validate in 399 of 400 with either gains, the hop in 361 and 358.
 capture_place 15 and capture_ankle 1 were put to rule K (docs/JOURNAL.md, session 47), in a
 form that read "on its toes" from the ankle joint's angle; the kernel now reads the foot's tilt
-in the world (session 47 thought --grid gave the same counts in every cell; it does not, see
-above). Put to rule L (session 48) in that form: not adopted. --grid holds its pushes 0.2 s; as a one-tick blow the withholding
-costs falls (tuning states 1000-1059: 9 -> 12 at 15 / 1, 35 with capture_ankle 1 alone).
+in the world (session 47 thought --grid gave the same counts in every cell; it does not,
+see above). Put to rule L (session 48) in that form: not adopted. Session 47's grid held
+its pushes 0.2 s; --grid now also blows them in one tick, where the withholding costs falls
+(tuning states 1000-1059: 9 -> 12 at 15 / 1, 35 with capture_ankle 1 alone).
 """
 import argparse
 import sys
 from concurrent.futures import ProcessPoolExecutor
+
+from cpgbiped.envs.simulation.rollout import PUSH_TICK_S
 
 PLACE, ANKLE = 15.0, 1.0  # rad/m, share: the jump's corner (synchronous)
 GRID = ((0.0, 0.0), (10.0, 1.0), (15.0, 1.0), (20.0, 1.0), (30.0, 1.0), (10.0, 0.0), (0.0, 1.0))
 # (N s at 6 s, held s, friction): the first five are session 47's columns; the one-tick blows
 # (a 4 ms control tick) were added in session 48, after rule L found them (docs/JOURNAL.md)
 CONDITIONS = ((5.0, 0.2, 1.0), (-5.0, 0.2, 1.0), (0.0, 0.0, 1.0), (0.0, 0.0, 0.5),
-              (0.0, 0.0, 2.0), (5.0, 0.004, 1.0), (-5.0, 0.004, 1.0))
+              (0.0, 0.0, 2.0), (5.0, PUSH_TICK_S, 1.0), (-5.0, PUSH_TICK_S, 1.0))
 RULE = ("rule K (docs/JOURNAL.md, session 47): not met (in-family transitions 7 -> 5 of 16, "
         "cross-family 6 -> 3 of 8); rule L (session 48): not met (the jump's forward pushes "
         "from unused states 68 -> 67 of 100: held 28 -> 39, one-tick blows 40 -> 28; the hop "

@@ -197,11 +197,10 @@ def compare(base: list[dict], cand: list[dict]) -> list[tuple]:
 
 def to_json(held: dict, gains: str | None, eps: float) -> dict:
     """What --json writes: every single condition's outcome and each re-roll's counts (by
-    label; "jump stands with feedback" 1 or 0), re-roll 0 the baseline of clause()'s limits."""
-    base, _ = clause(held[0], None)
+    label; "jump stands with feedback" 1 or 0). gains: None for the committed file."""
 
     def counts(h):
-        n = {label(k): v for k, v in clause(h, base)[0].items()}
+        n = {label(k): v for k, v in clause(h, None)[0].items()}
         n["jump stands with feedback"] = int(h[("jump no fall with feedback",)])
         return n
 
@@ -214,12 +213,19 @@ def to_json(held: dict, gains: str | None, eps: float) -> dict:
 def _counts_of(path: str) -> tuple[list[dict], dict]:
     """A --json file's counts, one dict per draw, and the file itself; ValueError without
     counts, with fewer than two draws, or with draws that do not count the same things."""
-    d = json.loads(Path(path).read_text())
-    if "counts" not in d:
+    try:
+        d = json.loads(Path(path).read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not JSON ({e})") from None
+    if not isinstance(d, dict) or "counts" not in d:
         raise ValueError(f"{path} has no counts (written before --json wrote them)")
+    if not isinstance(d["counts"], dict) or not all(
+            isinstance(x, dict) and all(type(v) is int for v in x.values())
+            for x in d["counts"].values()):
+        raise ValueError(f"{path}: counts are not one {{name: integer}} per draw")
     draws = list(d["counts"].values())
     if len(draws) < 2:
-        raise ValueError(f"{path} has {len(draws)} draw; a standard error needs at least 2")
+        raise ValueError(f"{path} has {len(draws)} draw(s); a standard error needs at least 2")
     if any(set(x) != set(draws[0]) for x in draws):
         raise ValueError(f"{path}'s draws do not count the same things")
     return draws, d
@@ -229,8 +235,11 @@ def print_compare(base_path: str, cand_path: str) -> None:
     (base, bd), (cand, cd) = _counts_of(base_path), _counts_of(cand_path)
     if set(base[0]) != set(cand[0]):
         raise ValueError("the two files do not count the same things")
-    print(f"each count's mean over {len(base)} draws ({base_path}, gains {bd.get('gains')}, "
-          f"eps {bd.get('eps')}) and {len(cand)} ({cand_path}, gains {cd.get('gains')}, eps "
+    def gains(d):
+        return d.get("gains") or "the committed"
+
+    print(f"each count's mean over {len(base)} draws ({base_path}, gains {gains(bd)}, "
+          f"eps {bd.get('eps')}) and {len(cand)} ({cand_path}, gains {gains(cd)}, eps "
           f"{cd.get('eps')}): difference, 2 standard errors")
     if bd.get("eps") != cd.get("eps"):
         print("warning: the two files re-rolled by different eps")

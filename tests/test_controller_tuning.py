@@ -5,6 +5,7 @@ the conditions the tests report."""
 import functools
 import json
 import pickle
+import sys
 
 import numpy as np
 import pytest
@@ -878,7 +879,7 @@ def test_condition_coins_compare_flags_a_count_lower_by_more_than_two_standard_e
     assert rows["c"][4] and not rows["d"][4]
     # what --json writes is what --compare reads: counts by label, the jump's stand as 1 / 0
     held = {0: _coins_held(cc), 1: _coins_held(cc, pert=14, jump_stands=False),
-            2: _coins_held(cc, fam=5)}
+            2: _coins_held(cc, fam=5, ol_fail=1)}
     path = tmp_path / "coins.json"
     path.write_text(json.dumps(cc.to_json(held, "g.json", 1e-6)))
     draws, d = cc._counts_of(str(path))
@@ -887,13 +888,79 @@ def test_condition_coins_compare_flags_a_count_lower_by_more_than_two_standard_e
     assert [x["in-family"] for x in draws] == [7, 7, 5]
     assert [x["jump stands with feedback"] for x in draws] == [1, 0, 1]
     assert [x["feedback hop"] for x in draws] == [13, 13, 13]
+    assert [x["open loop hop"] for x in draws] == [13, 13, 12]
     refused = {"old.json": ({"0": {"validate walk table3 False": True}}, "no counts"),
                "one.json": ({"counts": {"0": {"a": 1}}}, "at least 2"),
                "mixed.json": ({"counts": {"0": {"a": 1}, "1": {"b": 1}}}, "same things")}
+    refused["text.json"] = ("not json", "not JSON")
+    refused["list.json"] = ({"counts": [1, 2]}, "not one")
+    refused["float.json"] = ({"counts": {"0": {"a": 1.5}, "1": {"a": 1}}}, "not one")
     for name, (content, msg) in refused.items():
-        (tmp_path / name).write_text(json.dumps(content))
+        (tmp_path / name).write_text(content if isinstance(content, str) else json.dumps(content))
         with pytest.raises(ValueError, match=msg):
             cc._counts_of(str(tmp_path / name))
+
+
+def test_condition_coins_compare_refuses_bad_files_with_one_line_and_exit_2(tmp_path, capsys,
+                                                                            monkeypatch):
+    """--compare on a file without counts, or on two files that count different things: one
+    line "condition_coins: error: ..." on stderr, exit 2, no table printed."""
+    cc = _script("condition_coins")
+    a, b, old = tmp_path / "a.json", tmp_path / "b.json", tmp_path / "old.json"
+    a.write_text(json.dumps({"counts": {"0": {"x": 1}, "1": {"x": 2}}}))
+    b.write_text(json.dumps({"counts": {"0": {"y": 1}, "1": {"y": 2}}}))
+    old.write_text(json.dumps({"0": {}}))
+    for files, msg in (((a, b), "do not count the same things"), ((old, a), "no counts"),
+                       ((a, tmp_path / "missing.json"), "missing.json")):
+        monkeypatch.setattr(sys, "argv", ["condition_coins.py", "--compare", *map(str, files)])
+        with pytest.raises(SystemExit) as e:
+            cc.main()
+        out, err = capsys.readouterr()
+        assert e.value.code == 2 and out == ""
+        assert err.startswith("condition_coins: error: ") and msg in err
+        assert err.count("\n") == 1
+
+
+def test_capture_response_grid_runs_each_condition_as_its_push_and_floor(monkeypatch, capsys):
+    """scripts/capture_response.py grid(): each cell's seven conditions reach the rollout as
+    session 47's five (+-5 N s held 0.2 s at 6 s, unpushed, friction x0.5, x2.0) and then the
+    one-tick blows (+-5 N s over one control tick), with the cell's gains at the jump's corner;
+    a rollout with fell_at set counts as a fall. Rollouts and the process pool replaced by
+    recorders."""
+    import cpgbiped.envs.simulation.rollout as ro
+
+    cr = _script("capture_response")
+    calls = []
+
+    class Rec:
+        def __init__(self, fell):
+            self.fell_at = 7.0 if fell else None
+
+    def fake_rollout(net, seconds, p, push=None, friction_scale=1.0, poses=True):
+        calls.append((seconds, push, friction_scale, p.corner("synchronous").capture_place,
+                      p.corner("synchronous").capture_ankle))
+        return Rec(push is not None and push[1] > 0)  # only forward pushes fall here
+
+    class Serial:
+        def __init__(self, n):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *a):
+            return False
+
+        map = staticmethod(map)
+
+    monkeypatch.setattr(ro, "rollout", fake_rollout)
+    monkeypatch.setattr(cr, "ProcessPoolExecutor", Serial)
+    cr.grid("jump", 2, ((15.0, 1.0),))
+    assert [c[1:3] for c in calls[::2]] == [((6.0, 5.0, 0.2), 1.0), ((6.0, -5.0, 0.2), 1.0),
+                                            (None, 1.0), (None, 0.5), (None, 2.0),
+                                            ((6.0, 5.0, 0.004), 1.0), ((6.0, -5.0, 0.004), 1.0)]
+    assert len(calls) == 14 and all(c[0] == 14.0 and c[3:] == (15.0, 1.0) for c in calls)
+    assert capsys.readouterr().out.splitlines()[-1].endswith("2 / 0 / 0 / 0 / 0 / 2 / 0 of 2")
 
 
 def test_condition_coins_outcomes_turn_rollouts_into_the_clause_s_single_conditions(monkeypatch):
