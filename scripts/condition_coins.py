@@ -44,6 +44,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from tests.test_physics import (CONDITION_IDS, CONDITIONS, PERTURBATION_IDS,  # noqa: E402
                                 PERTURBATIONS as _TEST_PERTURBATIONS)
+from tests.test_transition import CROSS, IN_FAMILY_CASES  # noqa: E402  (the tests' own ways)
 
 GAITS = ("walk", "run", "jump", "hop")
 # the tests' perturbations that issue 20 names: friction x0.5, x2.0, +-5 N s held 0.2 s
@@ -81,34 +82,32 @@ def job(task):
 
     r, eps, gains, kind, args = task
     p = params_for(r, eps, gains)
+
+    def k_of(fb):
+        return RECOMMENDED["ml"] if fb else 0.0
+
+    def changed(a, b, ramp, fb):  # the tests' protocol: the change at 8 s
+        return transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
+                          feedback=k_of(fb), params=p)[0]
+
     if kind == "validate":
         gait, cid, cond, fb = args
         cond = dict(cond)
         seed = cond.pop("seed", None)
         s = validate(build("ml", gait, seed=seed), gait, WINDOW_S, params=p,
-                     feedback=RECOMMENDED["ml"] if fb else 0.0, **cond).summary()
+                     feedback=k_of(fb), **cond).summary()
         return r, ("validate", gait, cid, fb), s
     if kind == "in-family":
-        a, b, ramp, fb = args
-        k = RECOMMENDED["ml"] if fb else 0.0
-        res, *_ = transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
-                             feedback=k, params=p)
+        res = changed(*args)
         # the transition's own verdict (no fall, A before, B settled), within 4 CPG cycles
-        return r, ("in-family", a, b, ramp, fb), res["switched"] and res["cycles_to_switch"] <= 4
+        return r, ("in-family", *args), res["switched"] and res["cycles_to_switch"] <= 4
     a, b = args  # cross-family: reached in one of four ways
-    for ramp in (0.0, 2.0):
-        for fb in (False, True):
-            k = RECOMMENDED["ml"] if fb else 0.0
-            res, *_ = transition("ml", a, b, 8.0, ramp, default_seconds(a, b, 8.0, ramp),
-                                 feedback=k, params=p)
-            if res["cycles_to_switch"] is not None:
-                return r, ("cross", a, b), True
-    return r, ("cross", a, b), False
+    reached = any(changed(a, b, ramp, fb)["cycles_to_switch"] is not None
+                  for ramp in (0.0, 2.0) for fb in (False, True))
+    return r, ("cross", a, b), reached
 
 
 def tasks(r: int, eps: float, gains: str | None = None) -> list:
-    from cpgbiped.envs.experiments.transition import IN_FAMILY
-
     out = []
     for fb in (False, True):
         out += [(r, eps, gains, "validate", (g, cid, cond, fb)) for g in GAITS
@@ -116,10 +115,9 @@ def tasks(r: int, eps: float, gains: str | None = None) -> list:
     out += [(r, eps, gains, "validate", (g, pid, cond, False)) for g in GAITS
             for pid, cond in PERTURBATIONS]
     out += [(r, eps, gains, "validate", (g, "state7", {"seed": 7}, False)) for g in GAITS]
-    out += [(r, eps, gains, "in-family", (a, b, ramp, fb)) for a, b in sorted(IN_FAMILY)
-            for ramp in (0.0, 2.0) for fb in (False, True)]
-    cross = [(a, b) for a in GAITS for b in GAITS if a != b and (a, b) not in IN_FAMILY]
-    out += [(r, eps, gains, "cross", pair) for pair in cross]
+    out += [(r, eps, gains, "in-family", (a, b, ramp, k != 0.0))
+            for a, b, ramp, k in IN_FAMILY_CASES]
+    out += [(r, eps, gains, "cross", pair) for pair in CROSS]
     return out
 
 

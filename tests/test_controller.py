@@ -608,6 +608,15 @@ def _posed(ankle_rad=0.0, vx=0.0, hips=(0.0, 0.0), knee_rad=0.0, rooty_rad=0.0):
     return m, d
 
 
+def _beyond(m, d):
+    """kernel.beyond_feet of the posed body, from the sensors the controller reads."""
+    from cpgbiped.envs.control.controller import kernel_index
+
+    ix = kernel_index(m)
+    return K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
+                         d.sensordata[ix[K.IX_COMVEL]])
+
+
 @pytest.mark.parametrize("ankle_rad,vx,hips,knee_rad,rooty_rad", [
     (0.0, 3.0, (0.0, 0.0), 0.0, 0.0),  # thrown forwards: the XcoM past the toes
     (-0.5, 3.0, (0.0, 0.0), 0.0, 0.0),  # on its toes (a shorter base)
@@ -639,11 +648,7 @@ def test_beyond_feet_is_the_extrapolated_com_past_the_toe_and_heel_sites(ankle_r
         want = xcom - min(heels)
     else:
         want = 0.0
-    from cpgbiped.envs.control.controller import kernel_index
-
-    ix = kernel_index(m)
-    got = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
-                        d.sensordata[ix[K.IX_COMVEL]])
+    got = _beyond(m, d)
     assert got == pytest.approx(want, abs=1e-9)
     assert (got != 0.0) == (hips[0] == hips[1] and abs(vx) > 1.0)  # the cases say what they test
 
@@ -678,15 +683,11 @@ def test_capture_place_moves_the_placing_thighs_by_the_xcom_beyond_the_toes():
     hip torque changes by kp_sw * w * capture_place * beyond, w = sigma (1 - kappa) the jump
     corner's share and kp_sw the blended swing stiffness, both read from the parameters, and
     beyond from the sites (the test above)."""
-    from cpgbiped.envs.control.controller import kernel_index
-
     place = 1.0  # rad/m: small enough that no hip torque reaches its clip
     u0, m, d = _jump_controls(CONTROL, 0.0, 1.2, lifted=True)
     u1, _, _ = _jump_controls(CONTROL.with_corner("synchronous", capture_place=place), 0.0, 1.2,
                               lifted=True)
-    ix = kernel_index(m)
-    beyond = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
-                           d.sensordata[ix[K.IX_COMVEL]])
+    beyond = _beyond(m, d)
     assert beyond > 0.05
     w = 1.0 / (1.0 + 1e-3)  # sigma as the kernel measures it from the averages set, kappa = 0
     kp_sw = w * CONTROL.synchronous.kp_sw + (1 - w) * CONTROL.alternating.kp_sw  # kappa = 0
@@ -721,9 +722,7 @@ def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, v
     for i in range(2):  # the case's foot: tilted past the gate, or flat
         assert (abs(K.foot_angle(d.qpos, ix, i)) > K.CAPTURE_TILT_RAD) == (ankle_rad != 0.0
                                                                          and not crouch)
-    beyond = K.beyond_feet(d.qpos, d.sensordata, d.xpos, ix, d.sensordata[ix[K.IX_COM]],
-                           d.sensordata[ix[K.IX_COMVEL]])
-    assert np.sign(beyond) == np.sign(vx)  # the XcoM has left the feet in every case
+    assert np.sign(_beyond(m, d)) == np.sign(vx)  # the XcoM has left the feet in every case
     u1, _, _ = _jump_controls(every_corner(capture_ankle=1.0), ankle_rad, vx, False, crouch)
     u_none, _, _ = _jump_controls(every_corner(k_ax=0.0, k_av=0.0), ankle_rad, vx, False, crouch)
     muscles = slice(2, 4) if vx > 0 else slice(0, 2)  # b > 0: extensors; b < 0: flexors

@@ -109,8 +109,8 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        (x_sup = x_com with no support; beyond as in step 3, the capture response: blended
        capture_place, rad per m, neutral 0; the feet go where the extrapolated centre of mass
        has gone; 0 with capture_ankle 0 in the committed gains: 15 and 1 at the jump's corner
-       kept every test perturbation but failed rule K on the transitions, journal session 47,
-       scripts/capture_response.py),
+       kept every test perturbation but failed rule K on the transitions (journal, session
+       47) and rule L on one-tick blows (session 48); scripts/capture_response.py),
        tau_i = kp_sw (theta - thigh_i) - kd_sw thigh_rate_i  [ - kf_t tau_torso in flight ];
    support legs share what holds the torso: tau_i = (tau_torso - sum of the others' tau) / n.
 5. Knees:
