@@ -25,8 +25,6 @@ from cpgbiped.cpg.feedback import inputs as fb_inputs
 from cpgbiped.cpg.feedback import outputs as fb_outputs
 from cpgbiped.envs.gaits.gait_metrics import G as G_MPS2
 from cpgbiped.envs.gaits.gait_metrics import Z_FLOOR_M
-import os as _os
-FB_FADE_S = float(_os.environ.get('CPGB_FBFADE', '0'))  # PROTOTYPE
 
 # Parameter layout (the float array P; envs.controller.params_array builds it):
 # the shared parameters, then each blended gain's values at the four pattern corners, in
@@ -610,8 +608,6 @@ def step_closed(advance_first, code, NP, P_ab, knots, y, K, n_sub, h, noise, ste
     controls into ``ctrl``. The network's parameters ``NP`` move along ``knots`` between the
     rows of ``P_ab`` (a parameter change; held over the tick at their value at its start).
     Returns False when the network's state left its range."""
-    if FB_FADE_S > 0.0:
-        K = K * (1.0 - math.exp(-t_s / FB_FADE_S))
     if advance_first:
         fb_blend_at(t_s - tick_s, P_ab, knots, NP)
         # ``fb``: the terms computed at the last tick from ``sensors`` and this same state
