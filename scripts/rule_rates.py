@@ -40,7 +40,10 @@ presets 6070-6169); 6170-6269 and 6270-6369 rules J and J', the hop's start-up c
 46); 6370-6469 rule K, the jump's capture response (session 47); 6470-6599 rule L, the same
 response judged with the tests' conditions as distributions (session 48: the presets
 6470-6569, the transitions 6570-6599); 6600-6729 rule M, the hop's start-up corner of rule J'
-judged the same way (the presets 6600-6699, the transitions 6700-6729). Unused: 6730 and up.
+judged the same way (the presets 6600-6699, the transitions 6700-6729); 6730-6859 rule N, the
+feedback faded in over the start-up (session 49: the presets with feedback 6730-6829; 6830-6859
+declared, not run), 6860-6989 rule O, the run's start-up corner (the presets 6860-6959;
+6960-6989 declared, not run). Unused: 6990 and up.
 The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a
 note (re-counting that rule is what it is for then).
 """
@@ -64,7 +67,8 @@ USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 241
               (2500, 2999), (3000, 3099), (4000, 4099), (5000, 5099), (5100, 5199),
               (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519), (5520, 5579),
               (5580, 5759), (5760, 5779), (5780, 5909), (5910, 6039), (6040, 6169),
-              (6170, 6369), (6370, 6469), (6470, 6599), (6600, 6729))
+              (6170, 6369), (6370, 6469), (6470, 6599), (6600, 6729), (6730, 6859),
+              (6860, 6989))
 
 
 def one(job):
