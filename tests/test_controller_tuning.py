@@ -904,13 +904,15 @@ def test_condition_coins_compare_flags_a_count_lower_by_more_than_two_standard_e
 def test_condition_coins_compare_refuses_bad_files_with_one_line_and_exit_2(tmp_path, capsys,
                                                                             monkeypatch):
     """--compare on a file without counts, or on two files that count different things: one
-    line "condition_coins: error: ..." on stderr, exit 2, no table printed."""
+    line "condition_coins: error: ..." on stderr, exit 2, no table printed; for two files that
+    count different things, the line names each file's counts the other lacks."""
     cc = _script("condition_coins")
     a, b, old = tmp_path / "a.json", tmp_path / "b.json", tmp_path / "old.json"
     a.write_text(json.dumps({"counts": {"0": {"x": 1}, "1": {"x": 2}}}))
     b.write_text(json.dumps({"counts": {"0": {"y": 1}, "1": {"y": 2}}}))
     old.write_text(json.dumps({"0": {}}))
-    for files, msg in (((a, b), "do not count the same things"), ((old, a), "no counts"),
+    for files, msg in (((a, b), f"do not count the same things: ['x'] only in {a}; ['y'] only "
+                                f"in {b}"), ((old, a), "no counts"),
                        ((a, tmp_path / "missing.json"), "missing.json")):
         monkeypatch.setattr(sys, "argv", ["condition_coins.py", "--compare", *map(str, files)])
         with pytest.raises(SystemExit) as e:
