@@ -43,7 +43,8 @@ response judged with the tests' conditions as distributions (session 48: the pre
 judged the same way (the presets 6600-6699, the transitions 6700-6729); 6730-6859 rule N, the
 feedback faded in over the start-up (session 49: the presets with feedback 6730-6829; 6830-6859
 declared, not run), 6860-6989 rule O, the run's start-up corner (the presets 6860-6959;
-6960-6989 declared, not run). Unused: 6990 and up.
+6960-6989 declared, not run), 6990-7119 rule P, the run's start-up corner searched (the presets
+6990-7089; 7090-7119 declared, not run). Unused: 7120 and up.
 The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a
 note (re-counting that rule is what it is for then).
 """
@@ -68,7 +69,7 @@ USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 241
               (5200, 5249), (5250, 5329), (5330, 5419), (5420, 5519), (5520, 5579),
               (5580, 5759), (5760, 5779), (5780, 5909), (5910, 6039), (6040, 6169),
               (6170, 6369), (6370, 6469), (6470, 6599), (6600, 6729), (6730, 6859),
-              (6860, 6989))
+              (6860, 6989), (6990, 7119))
 
 
 def one(job):
