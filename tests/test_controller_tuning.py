@@ -1035,33 +1035,38 @@ def test_capture_response_grid_takes_cells_and_refuses_bad_ones():
             cr.cells_arg(bad)
 
 
-def test_run_startup_search_starts_from_the_blend_and_rolls_out_its_three_terms(monkeypatch):
-    """scripts/run_startup_search.py (journal, session 49, rule P): its start moves each gain
-    of the run's start-up corner BLEND = 0.2 of the way to the run corner's (hand-computed:
-    1 -> 1.2 towards 2, -2 -> -1 towards 3), and nothing else, not even its input; its
-    rollouts are the run on friction x0.7 from 16 states, the run from 16 others alternately
-    on x0.5 and pushed -5 N s held 0.2 s at 6 s, and walk, jump and hop from 8 more each,
-    every state a tuning state (1000-1099)."""
+def test_run_startup_search_starts_from_the_blend_and_names_its_three_terms_rollouts(monkeypatch):
+    """scripts/run_startup_search.py (journal, session 49, rule P): its start moves every gain of
+    the run's start-up corner BLEND = 0.2 of the way to the run corner's, opt-in ones included
+    (hand-computed: 1 -> 1.2 towards 2, -2 -> -1 towards 3, toe_up 0 -> 0.1 towards 0.5), and
+    nothing else, not even its input; its rollouts are the run on friction x0.7 from 16 states,
+    the run from 16 others alternately on x0.5 and on x1.0 pushed -5 N s held 0.2 s at 6 s,
+    and walk, jump and hop on x1.0 unpushed from 8 more, all tuning states (1000-1099), the
+    three groups' states disjoint."""
     from pathlib import Path
 
     monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "scripts"))
     rs = _script("run_startup_search")
-    g = {"startup": {"corners": {"alternating_coactive": {"a": 1.0, "b": -2.0},
+    g = {"startup": {"corners": {"alternating_coactive": {"a": 1.0, "b": -2.0, "toe_up": 0.0},
                                  "alternating": {"a": 5.0}}},
-         "corners": {"alternating_coactive": {"a": 2.0, "b": 3.0}, "alternating": {"a": 7.0}}}
+         "corners": {"alternating_coactive": {"a": 2.0, "b": 3.0, "toe_up": 0.5},
+                     "alternating": {"a": 7.0}}}
     before = json.dumps(g)
     b = rs.blended(g)
-    assert b["startup"]["corners"]["alternating_coactive"] == pytest.approx({"a": 1.2, "b": -1.0})
+    assert b["startup"]["corners"]["alternating_coactive"] == pytest.approx(
+        {"a": 1.2, "b": -1.0, "toe_up": 0.1})
     assert b["startup"]["corners"]["alternating"] == {"a": 5.0}
     assert b["corners"] == g["corners"] and json.dumps(g) == before
     jobs = rs.jobs("P")
-    duty = [j for j in jobs if j[0] == "duty"]
-    pushed = [j for j in jobs if j[0] == "pushed"]
-    guard = [j for j in jobs if j[0] == "guard"]
-    assert len(duty) == 16 and all(j[2:] == ("run", j[3], 0.7, None) for j in duty)
-    assert len(pushed) == 16 and all(j[2] == "run" for j in pushed)
-    assert sorted((j[4], j[5]) for j in pushed) == [(0.5, None)] * 8 + [(1.0, (6.0, -5.0, 0.2))] * 8
-    assert sorted(j[2] for j in guard) == ["hop"] * 8 + ["jump"] * 8 + ["walk"] * 8
-    seeds = [j[3] for j in jobs]
-    assert all(1000 <= s <= 1099 for s in seeds) and all(j[1] == "P" for j in jobs)
-    assert len(set(j[3] for j in duty + pushed)) == 32  # the two run terms share no state
+    assert all(j[1] == "P" for j in jobs)
+    groups = {k: [j for j in jobs if j[0] == k] for k in ("duty", "pushed", "guard")}
+    assert [len(v) for v in groups.values()] == [16, 16, 24] and len(jobs) == 56
+    assert all((j[2], j[4], j[5]) == ("run", 0.7, None) for j in groups["duty"])
+    assert [(j[2], j[4], j[5]) for j in groups["pushed"]] == [
+        ("run", 0.5, None), ("run", 1.0, (6.0, -5.0, 0.2))] * 8
+    assert sorted(j[2] for j in groups["guard"]) == ["hop"] * 8 + ["jump"] * 8 + ["walk"] * 8
+    assert all((j[4], j[5]) == (1.0, None) for j in groups["guard"])
+    seeds = {k: {j[3] for j in v} for k, v in groups.items()}
+    assert [len(v) for v in seeds.values()] == [16, 16, 8]
+    assert not (seeds["duty"] & seeds["pushed"] or seeds["guard"] & (seeds["duty"] | seeds["pushed"]))
+    assert all(1000 <= x <= 1099 for v in seeds.values() for x in v)
