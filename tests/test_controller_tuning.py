@@ -790,6 +790,28 @@ def test_rule_rates_counts_each_clause_over_its_own_states():
     assert rr.noise(0, 100, 100) == 0.0
 
 
+def test_rule_rates_churn_counts_the_states_a_candidate_re_deals():
+    """rule_rates.churn: per preset, open loop and with feedback apart, the random states whose
+    pass the candidate lost and those it gained; perturbed rows and the Table 3 row never
+    count. Synthetic rows: equal totals (2 of 3 passes either way) hiding one state lost and
+    one gained, counted by hand."""
+    rr = _script("rule_rates")
+
+    def row(seed, passed, kind="unperturbed", feedback=0.0, gait="hop"):
+        return {"gait": gait, "seed": seed, "kind": kind, "feedback": feedback,
+                "passed": passed, "fell": False, "kept": passed}
+
+    base = [row(7000, True), row(7001, True), row(7002, False), row(7000, True, feedback=0.03),
+            row(7000, True, kind="push +5"), row(None, True)]
+    cand = [row(7000, True), row(7001, False), row(7002, True), row(7000, False, feedback=0.03),
+            row(7000, False, kind="push +5"), row(None, False)]
+    c = rr.churn(base, cand)
+    assert c["open loop hop"] == (1, 1)  # 7001 lost, 7002 gained; totals 2 and 2
+    assert c["feedback hop"] == (1, 0)
+    assert c["open loop walk"] == (0, 0) and set(c) == {
+        f"{m} {g}" for m in ("open loop", "feedback") for g in rr.GAITS}
+
+
 def test_rule_rates_refuses_the_tuning_and_test_states(monkeypatch, capsys):
     """A rule counted over tuning states (1000-1099) or the tests' (10-19) would not be a rule:
     refused with a usage error before any rollout."""
