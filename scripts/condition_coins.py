@@ -231,11 +231,12 @@ def _counts_of(path: str) -> tuple[list[dict], dict]:
 
 def print_compare(base_path: str, cand_path: str) -> None:
     (base, bd), (cand, cd) = _counts_of(base_path), _counts_of(cand_path)
-    if set(base[0]) != set(cand[0]):
-        only = [f"{sorted(set(x[0]) - set(y[0]))} only in {p}"
-                for x, y, p in ((base, cand, base_path), (cand, base, cand_path))
-                if set(x[0]) - set(y[0])]
+    kb, kc = set(base[0]), set(cand[0])
+    if kb != kc:
+        only = [f"{sorted(x - y)} only in {p}"
+                for x, y, p in ((kb, kc, base_path), (kc, kb, cand_path)) if x - y]
         raise ValueError("the two files do not count the same things: " + "; ".join(only))
+
     def gains(d):
         return d.get("gains") or "the committed"
 

@@ -46,7 +46,8 @@ import numpy as np
 
 # The walk's start-up search (scripts/, on sys.path when a script runs): its unit box, guard
 # rollouts and seeds are this search's too.
-from walk_startup_search import GUARD_SEEDS, guard_terms, searched_names  # noqa: E402
+from walk_startup_search import (GUARD_SEEDS, corner_search, guard_terms,  # noqa: E402
+                                 searched_names)
 from walk_startup_search import with_corner as _with_corner  # noqa: E402
 
 FIRST, N_HOP = 1000, 100  # the hop's tuning CPG states: FIRST .. FIRST + N_HOP - 1 (--n)
@@ -109,9 +110,7 @@ def score(ex, gains: dict, n: int) -> tuple:
 
 
 def main() -> None:
-    import cma
-
-    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES, set_by_hand
+    from cpgbiped.envs.search.controller_tuning import set_by_hand
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--start", required=True, help="gains file to start from")
     ap.add_argument("--n", type=int, default=N_HOP, help="the hop's tuning states, from 1000")
@@ -122,34 +121,16 @@ def main() -> None:
         ap.error("--n must be within 2-100 (tuning states 1000-1099) and --gens within 1-200")
     try:
         base = json.loads(Path(a.start).read_text())
-        c0 = base["startup"]["corners"][CORNER]
+        base["startup"]["corners"][CORNER]  # a KeyError without start-up gains
     except (OSError, ValueError, KeyError, TypeError) as e:
         ap.error(f"--start {a.start}: not a gains file with start-up gains ({e!r})")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     names = searched_names()
-    x0 = [(c0[g] - CORNER_RANGES[g][0]) / (CORNER_RANGES[g][1] - CORNER_RANGES[g][0])
-          for g in names]
-    es = cma.CMAEvolutionStrategy(x0, SIGMA, {"seed": SEED, "popsize": POP, "bounds": [0, 1],
-                                              "verbose": -9})
-    history = []
     with ProcessPoolExecutor(2) as ex:
-        best_f, best_info = score(ex, base, a.n)
-        best_x = np.array(x0)
-        print(f"hop_startup_search: start score {best_f:.3f} {best_info}", flush=True)
-        history.append({"gen": -1, "score": best_f, **best_info})
-        for gen in range(a.gens):
-            X = es.ask()
-            F = []
-            for x in X:
-                f, info = score(ex, with_corner(base, np.asarray(x)), a.n)
-                F.append(f)
-                if f < best_f:
-                    best_f, best_x, best_info = f, np.asarray(x), info
-            es.tell(X, F)
-            history.append({"gen": gen, "score": best_f, **best_info})
-            print(f"hop_startup_search: gen {gen}: best {best_f:.3f} {best_info}", flush=True)
-            (out / "history.json").write_text(json.dumps(history, indent=1))
+        best_x, best_f, best_info, history = corner_search(
+            "hop_startup_search", lambda g: score(ex, g, a.n), base, CORNER, SEED, POP, SIGMA,
+            a.gens, out)
     best = with_corner(base, best_x)["startup"]["corners"][CORNER]
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in names}, out / "gains.json",
                 NOTE.format(start=a.start, out=a.out, first=FIRST, last=FIRST + a.n - 1,

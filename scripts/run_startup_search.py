@@ -29,8 +29,8 @@ blend's values).
     python scripts/run_startup_search.py --start GAINS.json [--gens 10] [--out out/run_startup]
 
 Writes OUT/gains.json (START's gains with every gain of the corner replaced, and a
-set_by_hand provenance entry naming this command) and OUT/history.json (every generation's best). About 12 minutes on
-2 cores.
+set_by_hand provenance entry naming this command) and OUT/history.json (every generation's
+best). About 12 minutes on 2 cores.
 """
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walk_startup_search import searched_names  # noqa: E402  (scripts/ is on sys.path)
+from walk_startup_search import corner_search, searched_names  # noqa: E402  (scripts/ on sys.path)
 from walk_startup_search import with_corner as _with_corner  # noqa: E402
 
 CORNER = "alternating_coactive"
@@ -109,9 +109,7 @@ def score(ex, gains: dict) -> tuple:
 
 
 def main() -> None:
-    import cma
-
-    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES, set_by_hand
+    from cpgbiped.envs.search.controller_tuning import set_by_hand
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--start", required=True, help="gains file to start from")
     ap.add_argument("--gens", type=int, default=GENS)
@@ -126,29 +124,10 @@ def main() -> None:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     names = searched_names()
-    c0 = base["startup"]["corners"][CORNER]
-    x0 = [float(np.clip((c0[g] - CORNER_RANGES[g][0])
-                        / (CORNER_RANGES[g][1] - CORNER_RANGES[g][0]), 0.0, 1.0)) for g in names]
-    es = cma.CMAEvolutionStrategy(x0, SIGMA, {"seed": SEED, "popsize": POP, "bounds": [0, 1],
-                                              "verbose": -9})
-    history = []
     with ProcessPoolExecutor(2) as ex:
-        best_f, best_info = score(ex, base)
-        best_x = np.array(x0)
-        print(f"run_startup_search: start score {best_f:.3f} {best_info}", flush=True)
-        history.append({"gen": -1, "score": best_f, **best_info})
-        for gen in range(a.gens):
-            X = es.ask()
-            F = []
-            for x in X:
-                f, info = score(ex, _with_corner(base, np.asarray(x), CORNER))
-                F.append(f)
-                if f < best_f:
-                    best_f, best_x, best_info = f, np.asarray(x), info
-            es.tell(X, F)
-            history.append({"gen": gen, "score": best_f, **best_info})
-            print(f"run_startup_search: gen {gen}: best {best_f:.3f} {best_info}", flush=True)
-            (out / "history.json").write_text(json.dumps(history, indent=1))
+        best_x, best_f, best_info, history = corner_search(
+            "run_startup_search", lambda g: score(ex, g), base, CORNER, SEED, POP, SIGMA, a.gens,
+            out, clip=True)
     best = _with_corner(base, best_x, CORNER)["startup"]["corners"][CORNER]
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in best}, out / "gains.json",
                 NOTE.format(start=a.start, out=a.out, gens=a.gens, score=best_f,

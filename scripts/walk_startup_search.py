@@ -98,6 +98,45 @@ def with_corner(base: dict, x_unit: np.ndarray, corner: str = CORNER) -> dict:
     return d
 
 
+def corner_search(label: str, score_of, base: dict, corner: str, seed: int, pop: int,
+                  sigma: float, gens: int, out: Path | None = None, clip: bool = False):
+    """CMA-ES (the ``cma`` library, ask/tell) over the searched gains of the start-up corner
+    ``corner`` in the unit box of CORNER_RANGES, from ``base``'s values (``clip``: those outside
+    the box moved onto it); ``score_of(gains dict) -> (score, info)``, lower is better. Prints
+    each generation's best as ``label``; with ``out``, writes out/history.json after each.
+    Returns (the best unit point, its score, its info, the history: the start, then each
+    generation's best). The loop of this search, scripts/hop_startup_search.py's and
+    scripts/run_startup_search.py's."""
+    import cma
+
+    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES
+    c0 = base["startup"]["corners"][corner]
+    x0 = [(c0[g] - CORNER_RANGES[g][0]) / (CORNER_RANGES[g][1] - CORNER_RANGES[g][0])
+          for g in searched_names()]
+    if clip:
+        x0 = [float(np.clip(x, 0.0, 1.0)) for x in x0]
+    es = cma.CMAEvolutionStrategy(x0, sigma, {"seed": seed, "popsize": pop, "bounds": [0, 1],
+                                              "verbose": -9})
+    best_f, best_info = score_of(base)
+    best_x = np.array(x0)
+    print(f"{label}: start score {best_f:.3f} {best_info}", flush=True)
+    history = [{"gen": -1, "score": best_f, **best_info}]
+    for gen in range(gens):
+        X = es.ask()
+        F = []
+        for x in X:
+            f, info = score_of(with_corner(base, np.asarray(x), corner))
+            F.append(f)
+            if f < best_f:
+                best_f, best_x, best_info = f, np.asarray(x), info
+        es.tell(X, F)
+        history.append({"gen": gen, "score": best_f, **best_info})
+        print(f"{label}: gen {gen}: best {best_f:.3f} {best_info}", flush=True)
+        if out is not None:
+            (out / "history.json").write_text(json.dumps(history, indent=1))
+    return best_x, best_f, best_info, history
+
+
 def rollout_terms(job) -> tuple:
     """(fell, peak pitch in the early window (rad), seconds in the air in it) of job (params,
     gait, seed). A rollout stops at a fall, and the seconds in the air are then its airborne
@@ -150,9 +189,6 @@ def score(ex, gains: dict, guard_kind: str = "criteria") -> tuple:
 
 
 def main() -> None:
-    import cma
-
-    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--start", required=True, help="gains file to start from")
     ap.add_argument("--guard", choices=("criteria", "falls"), default="criteria",
@@ -165,31 +201,12 @@ def main() -> None:
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    start_text = Path(a.start).read_text()
-    base = json.loads(start_text)
+    base = json.loads(Path(a.start).read_text())
     names = searched_names()
-    c0 = base["startup"]["corners"][CORNER]
-    x0 = [(c0[g] - CORNER_RANGES[g][0]) / (CORNER_RANGES[g][1] - CORNER_RANGES[g][0])
-          for g in names]
-    es = cma.CMAEvolutionStrategy(x0, SIGMA, {"seed": SEED, "popsize": POP, "bounds": [0, 1],
-                                              "verbose": -9})
-    history = []
     with ProcessPoolExecutor(2) as ex:
-        best_f, best_info = score(ex, base, a.guard)
-        best_x = np.array(x0)
-        print(f"walk_startup_search: start score {best_f:.3f} {best_info}", flush=True)
-        history.append({"gen": -1, "score": best_f, **best_info})
-        for gen in range(GENS):
-            X = es.ask()
-            F = []
-            for x in X:
-                f, info = score(ex, with_corner(base, np.asarray(x)), a.guard)
-                F.append(f)
-                if f < best_f:
-                    best_f, best_x, best_info = f, np.asarray(x), info
-            es.tell(X, F)
-            history.append({"gen": gen, "score": best_f, **best_info})
-            print(f"walk_startup_search: gen {gen}: best {best_f:.3f} {best_info}", flush=True)
+        best_x, best_f, best_info, history = corner_search(
+            "walk_startup_search", lambda g: score(ex, g, a.guard), base, CORNER, SEED, POP,
+            SIGMA, GENS)
     from cpgbiped.envs.search.controller_tuning import set_by_hand
     best = with_corner(base, best_x)["startup"]["corners"][CORNER]
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in names}, out / "gains.json",

@@ -1092,3 +1092,40 @@ def test_run_startup_search_starts_from_the_blend_and_names_its_three_terms_roll
     assert [len(v) for v in seeds.values()] == [16, 16, 8]
     assert not (seeds["duty"] & seeds["pushed"] or seeds["guard"] & (seeds["duty"] | seeds["pushed"]))
     assert all(1000 <= x <= 1099 for v in seeds.values() for x in v)
+
+
+def test_corner_search_keeps_the_best_point_it_scored(monkeypatch, tmp_path, capsys):
+    """scripts/walk_startup_search.corner_search, the CMA-ES loop of the three start-up
+    searches (walk, hop, run): scored with a bowl computed here from the corner's gains in the
+    unit box of CORNER_RANGES (minimum at its centre), the history starts at the start's own
+    score, never rises, ends at the returned best, which is the score of the returned point put
+    back into the corner; history.json holds the same history; nothing outside the corner
+    moves."""
+    from pathlib import Path
+
+    from cpgbiped.envs.search.controller_tuning import CORNER_RANGES
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "scripts"))
+    ws = _script("walk_startup_search")
+    corner = "alternating_coactive"
+    base = json.loads((Path(__file__).resolve().parents[1] / "envs" / "control"
+                       / "gains.json").read_text())
+
+    def bowl(gains):
+        c = gains["startup"]["corners"][corner]
+        u = [(c[g] - CORNER_RANGES[g][0]) / (CORNER_RANGES[g][1] - CORNER_RANGES[g][0])
+             for g in ws.searched_names()]
+        return float(sum((x - 0.5) ** 2 for x in u)), {}
+
+    x, f, _, history = ws.corner_search("t", bowl, base, corner, seed=1, pop=6, sigma=0.1,
+                                        gens=3, out=tmp_path)
+    scores = [h["score"] for h in history]
+    assert scores[0] == bowl(base)[0] and len(scores) == 4
+    assert all(b <= a for a, b in zip(scores, scores[1:])) and scores[-1] == f < scores[0]
+    moved = ws.with_corner(base, x, corner)
+    assert bowl(moved)[0] == pytest.approx(f, abs=1e-12)
+    assert moved["corners"] == base["corners"]
+    assert {k: v for k, v in moved["startup"]["corners"].items() if k != corner} == {
+        k: v for k, v in base["startup"]["corners"].items() if k != corner}
+    assert json.loads((tmp_path / "history.json").read_text()) == history
+    assert "t: gen 2: best" in capsys.readouterr().out
