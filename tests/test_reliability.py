@@ -125,14 +125,17 @@ def test_ctrl_c_at_every_write_leaves_the_old_or_the_new_set(tmp_path, old_and_n
 def test_ctrl_c_by_signal_at_many_moments(tmp_path, old_and_new):
     """SIGINT to a real process at moments spread over a run: old or new set, never mixed."""
     d = fresh_old_folder(tmp_path, old_and_new)
-    t0 = time.perf_counter()
-    r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--seed", "2", "--out", str(d)],
-                       capture_output=True, timeout=300)
-    total = time.perf_counter() - t0
-    assert r.returncode == 0
-    assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    durations = []  # the first run in a process tree can be slower (caches): time two, keep the shorter
+    for _ in range(2):
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--seed", "2", "--out",
+                            str(d)], capture_output=True, timeout=300)
+        durations.append(time.perf_counter() - t0)
+        assert r.returncode == 0
+        assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
+    total = min(durations)
     landed = 0  # interrupts that reached a run in progress (not one already finished)
-    for frac in np.linspace(0.3, 1.0, 8):
+    for frac in np.linspace(0.2, 0.9, 8):
         p = subprocess.Popen([sys.executable, "-m", "cpgbiped.envs.cli", *OPT, "--seed", "2",
                               "--out", str(d)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         time.sleep(frac * total)
@@ -146,7 +149,7 @@ def test_ctrl_c_by_signal_at_many_moments(tmp_path, old_and_new):
         assert snapshot(d) in (old_and_new[1], old_and_new[2]), frac
         if snapshot(d) == old_and_new[2]:
             assert main(OPT + ["--seed", "1", "--out", str(d)]) == 0
-    assert landed >= 3  # most of the moments lie inside the run (30-100% of its length)
+    assert landed >= 3, durations  # most moments lie inside the run (20-90% of its shortest length)
 
 
 def test_two_runs_into_one_folder_one_fails_with_one_line(tmp_path):
