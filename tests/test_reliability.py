@@ -373,13 +373,17 @@ def test_sigterm_at_many_moments_of_a_physics_search(tmp_path):
     run with two worker processes: exit 143 with one line, the target old (absent here) or
     complete, no staging folder left, no process of the run left; the next run succeeds."""
     out = tmp_path / "phys"
-    t0 = time.perf_counter()
-    p = _start(PHYS, out)
-    assert p.wait(timeout=300) == 0, p.stderr.read()
-    total = time.perf_counter() - t0
+    durations = []  # two timed runs, the shorter kept: the first can be slower (caches)
+    for _ in range(2):
+        shutil.rmtree(out, ignore_errors=True)
+        t0 = time.perf_counter()
+        p = _start(PHYS, out)
+        assert p.wait(timeout=300) == 0, p.stderr.read()
+        durations.append(time.perf_counter() - t0)
+    total = min(durations)
     done = sorted(f.name for f in out.iterdir())
     terminated = 0
-    for frac in (0.3, 0.5, 0.7, 0.9):
+    for frac in (0.2, 0.4, 0.6, 0.8):
         shutil.rmtree(out, ignore_errors=True)
         p = _start(PHYS, out)
         time.sleep(frac * total)
@@ -396,7 +400,7 @@ def test_sigterm_at_many_moments_of_a_physics_search(tmp_path):
         # the target: untouched (absent here) or complete (the signal came after the commit)
         assert not out.exists() or sorted(f.name for f in out.iterdir()) == done
         assert not list(tmp_path.glob(".phys.staging-*"))
-    assert terminated >= 2
+    assert terminated >= 2, durations
     assert _start(PHYS, out).wait(timeout=300) == 0
 
 
