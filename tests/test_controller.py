@@ -189,6 +189,12 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
     assert ds["on"] > ds["off"] + 0.02, ds
 
 
+# The run corner's stance knee stiffness (kp_knee) before rule Q (session 50,
+# scripts/run_knee_stiffness.py multiplied it by 1.25): the gains that the landing yield was
+# measured on and that sync_land was adopted with.
+KP_KNEE_RUN_BEFORE_Q = 3.0835338064274307
+
+
 def test_landing_yield_lets_the_knee_give_before_it_pushes():
     """land_yield withholds the extensor burst's knee drive after a landing until the knee's
     flexion stops. At 0 (the committed gains) the run's knee extends at once when it lands
@@ -196,15 +202,20 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     in the first 60 ms after touchdown. (At its neutral 0 it leaves the rollouts of older gains files
     unchanged, bit for bit: tests/test_feedback.py's recorded rows.) The landings counted are
     those from 1 s to the first fall of either rollout; the corner's gain is set in the
-    start-up gains too, so that it acts from the start rather than as they hand over."""
+    start-up gains too, so that it acts from the start rather than as they hand over. Measured
+    with the run corner's stance knee as it was before rule Q (KP_KNEE_RUN_BEFORE_Q): with
+    the committed stiffer knee the run with land_yield 1 no longer falls at 2.6 s, and over
+    1-5 s the knee gives 0.0065 and 0.0079 rad (18 and 30 landings), not twice as far; the
+    yield is in no committed gains."""
     from dataclasses import replace
 
     from cpgbiped.envs.simulation.rollout import rollout
 
     give = {}
     recs = {}
+    before_q = CONTROL.with_corner("alternating_coactive", kp_knee=KP_KNEE_RUN_BEFORE_Q)
     for y in (0.0, 1.0):
-        p = CONTROL.with_corner("alternating_coactive", land_yield=y)
+        p = before_q.with_corner("alternating_coactive", land_yield=y)
         if p.startup is not None:
             k = K.CORNERS.index("alternating_coactive")
             p = replace(p, startup=tuple(replace(c, land_yield=y) if i == k else c
@@ -437,13 +448,16 @@ def test_sync_land_acts_only_on_a_lone_foot_and_keeps_stumbling_hops_up():
     the margin is zero; 1046, the state the stumble was traced from, falls at 4.9 s with it,
     earlier than without, and 1094 at 8.5 s). Measured on the gains it was adopted with: the
     committed ones with pitch_tau_s = 0 (session 44 set it to 1 s, which moves every rollout
-    after the start-up, so that these five states no longer all fall without sync_land)."""
+    after the start-up, so that these five states no longer all fall without sync_land) and
+    the run corner's stance knee before rule Q (session 50: with the stiffer knee, without
+    sync_land two of the five do not fall, and the others fall at 4.8, 6.0 and 7.2 s)."""
     from dataclasses import replace
 
     from cpgbiped.envs.simulation.rollout import rollout
 
     assert CONTROL.sync_land > 0.5  # the committed gains have it on
-    base = replace(CONTROL, pitch_tau_s=0.0)  # the gains sync_land was adopted with
+    base = replace(CONTROL, pitch_tau_s=0.0).with_corner(  # the gains sync_land was adopted with
+        "alternating_coactive", kp_knee=KP_KNEE_RUN_BEFORE_Q)
     kept = 0
     for seed in (1046, 1049, 1052, 1060, 1094):
         net = build("ml", "hop", seed=seed)
