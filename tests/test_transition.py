@@ -186,7 +186,9 @@ IN_FAMILY_SHORTFALL = {
     # step with feedback, hop -> jump as a step and a ramp with feedback, jump -> hop as a step
     # either way; the gated pathway is near zero in the hop's and the jump's rhythms, so it no
     # longer carries hop -> jump in time (over 30 random states it still switches in 22 and 18:
-    # README "Transitions").
+    # README "Transitions"). Since the run corner's stiffer stance knee (session 50) 6 of 16:
+    # walk -> run as a ramp with feedback is gained, jump -> hop open loop as a step and as a
+    # ramp are lost.
     ("walk", "run", 0.0, 0.0): "falls at 10.0 s, 2.0 s after the change (a run 3 CPG cycles "
                                "after it, no fall, before pitch_tau_s)",
     ("walk", "run", 0.0, K_FB): "falls at 9.9 s, 1.9 s after the change (9.8 s before the run "
@@ -206,7 +208,8 @@ IN_FAMILY_SHORTFALL = {
                                "legs together",
     # jump -> hop open loop: a hop 4 cycles after the change as a step and as a ramp in
     # sessions 44-49; since the run corner's stiffer stance knee (session 50) both fall (over
-    # 21 re-rolls of the gains by nothing physical the step held in 9 of 21, against 6 before)
+    # 21 re-rolls of the gains by nothing physical the step held in 9 of 21, against 6 before,
+    # the ramp in 6 of 21, against 2)
     ("jump", "hop", 0.0, 0.0): "falls at 11.8 s, 3.8 s after the change",
     ("jump", "hop", 2.0, 0.0): "falls at 14.7 s, 4.7 s after the ramp ends",
     ("jump", "hop", 2.0, K_FB): "a hop 6 CPG cycles after the change, no fall (10 before "
