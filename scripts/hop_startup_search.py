@@ -39,26 +39,20 @@ from __future__ import annotations
 
 import argparse
 import json
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 # The walk's start-up search (scripts/, on sys.path when a script runs): its unit box, guard
 # rollouts and seeds are this search's too.
-from walk_startup_search import (GUARD_SEEDS, corner_search, guard_terms,  # noqa: E402
+from walk_startup_search import (GUARD_SEEDS, guard_terms, search_in_pool,  # noqa: E402
                                  searched_names)
-from walk_startup_search import with_corner as _with_corner  # noqa: E402
 
 FIRST, N_HOP = 1000, 100  # the hop's tuning CPG states: FIRST .. FIRST + N_HOP - 1 (--n)
 FRICTIONS = (1.0, 0.8, 1.25)
 START_S = 8.0  # the hop's scored seconds after the 2 s of settling
 POP, GENS, SIGMA, SEED = 12, 10, 0.06, 461
 CORNER = "synchronous_coactive"
-
-
-def with_corner(base: dict, x_unit: np.ndarray) -> dict:
-    return _with_corner(base, x_unit, CORNER)
 
 
 NOTE = ("the hop's start-up corner found by python scripts/hop_startup_search.py --start "
@@ -127,11 +121,9 @@ def main() -> None:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     names = searched_names()
-    with ProcessPoolExecutor(2) as ex:
-        best_x, best_f, best_info, history = corner_search(
-            "hop_startup_search", lambda g: score(ex, g, a.n), base, CORNER, SEED, POP, SIGMA,
-            a.gens, out)
-    best = with_corner(base, best_x)["startup"]["corners"][CORNER]
+    best, best_f, best_info, history = search_in_pool(
+        "hop_startup_search", lambda ex, g: score(ex, g, a.n), base, CORNER, SEED, POP, SIGMA,
+        a.gens, out)
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in names}, out / "gains.json",
                 NOTE.format(start=a.start, out=a.out, first=FIRST, last=FIRST + a.n - 1,
                             n=a.n, gens=a.gens, score=best_f,

@@ -36,13 +36,11 @@ from __future__ import annotations
 
 import argparse
 import json
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
-from walk_startup_search import corner_search, searched_names  # noqa: E402  (scripts/ on sys.path)
-from walk_startup_search import with_corner as _with_corner  # noqa: E402
+from walk_startup_search import search_in_pool, searched_names  # noqa: E402  (scripts/ on sys.path)
 
 CORNER = "alternating_coactive"
 BLEND = 0.2  # the search's start: the start-up corner this share of the way to the corner
@@ -124,11 +122,8 @@ def main() -> None:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     names = searched_names()
-    with ProcessPoolExecutor(2) as ex:
-        best_x, best_f, best_info, history = corner_search(
-            "run_startup_search", lambda g: score(ex, g), base, CORNER, SEED, POP, SIGMA, a.gens,
-            out, clip=True)
-    best = _with_corner(base, best_x, CORNER)["startup"]["corners"][CORNER]
+    best, best_f, best_info, history = search_in_pool(
+        "run_startup_search", score, base, CORNER, SEED, POP, SIGMA, a.gens, out, clip=True)
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in best}, out / "gains.json",
                 NOTE.format(start=a.start, out=a.out, gens=a.gens, score=best_f,
                             start_score=history[0]["score"], info=json.dumps(best_info)))

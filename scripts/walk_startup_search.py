@@ -137,6 +137,17 @@ def corner_search(label: str, score_of, base: dict, corner: str, seed: int, pop:
     return best_x, best_f, best_info, history
 
 
+def search_in_pool(label: str, score, base: dict, corner: str, seed: int, pop: int, sigma: float,
+                   gens: int, out: Path | None = None, clip: bool = False):
+    """:func:`corner_search` with ``score(executor, gains dict) -> (score, info)`` given a pool
+    of two worker processes. Returns (the best start-up corner's gains, its score, its info,
+    the history). The three start-up searches' main."""
+    with ProcessPoolExecutor(2) as ex:
+        x, f, info, history = corner_search(label, lambda g: score(ex, g), base, corner, seed,
+                                            pop, sigma, gens, out, clip=clip)
+    return with_corner(base, x, corner)["startup"]["corners"][corner], f, info, history
+
+
 def rollout_terms(job) -> tuple:
     """(fell, peak pitch in the early window (rad), seconds in the air in it) of job (params,
     gait, seed). A rollout stops at a fall, and the seconds in the air are then its airborne
@@ -203,12 +214,10 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     base = json.loads(Path(a.start).read_text())
     names = searched_names()
-    with ProcessPoolExecutor(2) as ex:
-        best_x, best_f, best_info, history = corner_search(
-            "walk_startup_search", lambda g: score(ex, g, a.guard), base, CORNER, SEED, POP,
-            SIGMA, GENS)
+    best, best_f, best_info, history = search_in_pool(
+        "walk_startup_search", lambda ex, g: score(ex, g, a.guard), base, CORNER, SEED, POP,
+        SIGMA, GENS)
     from cpgbiped.envs.search.controller_tuning import set_by_hand
-    best = with_corner(base, best_x)["startup"]["corners"][CORNER]
     set_by_hand(a.start, {f"startup.{CORNER}.{g}": best[g] for g in names}, out / "gains.json",
                 NOTE.format(start=a.start, out=a.out, guard=a.guard, score=best_f,
                             start_score=history[0]["score"], info=json.dumps(best_info))
