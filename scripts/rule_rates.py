@@ -46,7 +46,8 @@ judged the same way (the presets 6600-6699, the transitions 6700-6729); 6730-685
 feedback faded in over the start-up (session 49: the presets with feedback 6730-6829; 6830-6859
 declared, not run), 6860-6989 rule O, the run's start-up corner (the presets 6860-6959;
 6960-6989 declared, not run), 6990-7119 rule P, the run's start-up corner searched (the presets
-6990-7089; 7090-7119 declared, not run). Unused: 7120 and up.
+6990-7089; 7090-7119 declared, not run); 7120-7249 rule Q, the run corner's stance knee (the
+presets 7120-7219, the transitions 7220-7249; session 50). Unused: 7250 and up.
 The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a
 note (re-counting that rule is what it is for then).
 """

@@ -27,7 +27,7 @@ from cpgbiped.envs.search.controller_tuning import hand_set_link
 
 GAIN = "alternating_coactive.kp_knee"
 BEFORE = 3.0835338064274307  # the value the chain's links before this one end with
-KP_KNEE = 3.8544172580342884  # 1.25 x BEFORE: the value rule Q judged
+KP_KNEE = 1.25 * BEFORE  # the value rule Q judged (3.8544172580342884)
 RULE = ("rule Q (docs/JOURNAL.md, session 50; fixed in commit a393166 on 2026-12-07, before the "
         "candidate met any state outside tuning states 1000-1049; baseline the gains before it): "
         "Q1 the four presets on friction x0.7 from CPG seeds 7120-7219, open loop and with the "

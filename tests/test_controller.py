@@ -13,6 +13,7 @@ from cpgbiped.envs.control import control_kernel as K
 from cpgbiped.envs.simulation.biped import load_model
 from cpgbiped.envs.control.controller import (CONTROL, CPGController, CPGSchedule, cpg_schedule,
                              without_ankle_drive)
+from tests.test_controller_tuning import _script
 
 DT = 0.002
 
@@ -189,10 +190,10 @@ def test_double_support_reflexes_keep_the_trailing_foot_down():
     assert ds["on"] > ds["off"] + 0.02, ds
 
 
-# The run corner's stance knee stiffness (kp_knee) before rule Q (session 50,
+# The run corner's stance knee stiffness (kp_knee) before rule Q (session 50: the link
 # scripts/run_knee_stiffness.py multiplied it by 1.25): the gains that the landing yield was
 # measured on and that sync_land was adopted with.
-KP_KNEE_RUN_BEFORE_Q = 3.0835338064274307
+KP_KNEE_RUN_BEFORE_Q = _script("run_knee_stiffness").BEFORE
 
 
 def test_landing_yield_lets_the_knee_give_before_it_pushes():
