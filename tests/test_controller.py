@@ -210,7 +210,8 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     1-5 s the knee gives 0.0065 and 0.0079 rad (18 and 30 landings), not twice as far. What
     this measures is the rollout's give, not the gate at one landing: of the 9 and 14
     landings counted here most come outside the extensor burst, where the yield does not act
-    directly, and over the landings inside it the give is 0.0036 and 0.0013 rad (session 50)."""
+    directly, and over the landings inside it the give is 0.0036 and 0.0013 rad (session 50); the gate
+    itself is tested on the lifted body below."""
     from dataclasses import replace
 
     from cpgbiped.envs.simulation.rollout import rollout
@@ -250,6 +251,49 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     # run's start; what the test claims is the ratio, not the rad)
     assert give[0.0] < 0.02 and give[1.0] > 2.0 * give[0.0], give
 
+
+def _knee_controls_through_a_landing(land_yield):
+    """Both knees' controls, modes and yield states over five calls of a fresh controller on
+    the lifted body, both extensors bursting (land_yield at every corner, no start-up gains):
+    in the air at 1.000 s, then counted on the ground (their last contact at this tick) with
+    the knees flexing at 2 and 1 rad/s, then still (0) and extending (0.5 rad/s)."""
+    from dataclasses import replace
+
+    p = CONTROL
+    for c in K.CORNERS:
+        p = p.with_corner(c, land_yield=land_yield)
+    p = replace(p, startup=None)
+    m, d = lifted_body()
+    a = np.zeros((2000, 4))
+    a[:, 2:] = 1.0
+    ctl = CPGController(m, d, synthetic(a), params=p)
+    knees = [m.jnt_dofadr[m.joint(n).id] for n in ("left_knee", "right_knee")]
+    rows = []
+    for t, down, rate in ((1.000, False, 0.0), (1.004, True, -2.0), (1.008, True, -1.0),
+                          (1.012, True, 0.0), (1.016, True, 0.5)):
+        ctl.S[K.S_LAST_GROUND:K.S_LAST_GROUND + 2] = t if down else -1.0
+        d.qvel[knees] = rate
+        u = ctl(t).copy()
+        rows.append((u[6:8], ctl.modes, ctl.S[K.S_YIELD:K.S_YIELD + 2].copy()))
+    return rows
+
+
+def test_landing_yield_gate_withholds_the_drive_only_while_the_knee_flexes():
+    """The gate itself (the test above measures its effect on a rollout): a leg that lands in
+    its extensor burst is armed in the air (yield state 1), yields while its knee flexes
+    (state 2: the burst's knee drive withheld by land_yield, so that with land_yield 1 the
+    knee extends less than with 0), and takes up the drive once the flexion stops (state 0:
+    the same controls as with land_yield 0, to the bit, while flexing and after). Checked on
+    both legs, which land together."""
+    off, on = _knee_controls_through_a_landing(0.0), _knee_controls_through_a_landing(1.0)
+    assert list(on[0][1]) == [K.MODE_AIR] * 2 and list(on[0][2]) == [1.0, 1.0]
+    assert np.array_equal(on[0][0], off[0][0])  # in the air the yield does nothing
+    for k in (1, 2):  # landed, the knees flexing
+        assert list(on[k][1]) == [K.MODE_SUPPORT] * 2 and list(on[k][2]) == [2.0, 2.0]
+        assert np.all(on[k][0] < off[k][0] - 0.05), (k, on[k][0], off[k][0])
+    for k in (3, 4):  # the flexion has stopped: the drive is back
+        assert list(on[k][2]) == [0.0, 0.0]
+        assert np.array_equal(on[k][0], off[k][0]), (k, on[k][0], off[k][0])
 
 def _first_controls(params, a, t_s, sigma0=False):
     """The controls of a fresh controller's first call at t_s (s) on the lifted body: the
