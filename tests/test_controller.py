@@ -295,6 +295,46 @@ def test_landing_yield_gate_withholds_the_drive_only_while_the_knee_flexes():
         assert list(on[k][2]) == [0.0, 0.0]
         assert np.array_equal(on[k][0], off[k][0]), (k, on[k][0], off[k][0])
 
+def _knee_controls_on_load(force_fb, load_n, extensors=1.0):
+    """Both knees' controls at the second call of a fresh controller on the lifted body, both
+    feet counted on the ground (their last contact at this tick), both extensors at the given
+    activation and the flexors silent, each foot's contact sensor reading load_n newtons
+    (force_fb at every corner, no start-up gains)."""
+    from dataclasses import replace
+
+    p = CONTROL
+    for c in K.CORNERS:
+        p = p.with_corner(c, force_fb=force_fb)
+    p = replace(p, startup=None)
+    m, d = lifted_body()
+    a = np.zeros((2000, 4))
+    a[:, 2:] = extensors
+    ctl = CPGController(m, d, synthetic(a), params=p)
+    for t in (1.000, 1.004):
+        ctl.S[K.S_LAST_GROUND:K.S_LAST_GROUND + 2] = t
+        for i in range(2):
+            d.sensordata[ctl.ix[K.IX_FORCE + i]] = load_n
+        u = ctl(t).copy()
+    assert list(ctl.modes) == [K.MODE_SUPPORT] * 2
+    return u[6:8]
+
+
+@pytest.mark.parametrize("extensors", [1.0, 0.7])
+def test_force_feedback_adds_the_load_times_the_burst_to_the_knee(extensors):
+    """force_fb (gear per N; the controller's docstring, 5): on a support leg the knee's
+    extension torque grows by force_fb x drive x |F|, F the foot's contact force: with 300 N on
+    each foot and force_fb 1e-3, by 0.3 x the extensor's activation (the drive of a leg that
+    has not taken off in this burst), on both knees; at 0 N, or at force_fb 0, by nothing
+    (to the bit); and outside the burst (extensors silent) by nothing either."""
+    base = _knee_controls_on_load(0.0, 300.0, extensors)
+    fed = _knee_controls_on_load(1e-3, 300.0, extensors)
+    assert np.all(base < 0.6)  # room under the clip at 1, so that the sum is not cut
+    assert fed == pytest.approx(base + 0.3 * extensors, abs=1e-9)
+    assert np.array_equal(_knee_controls_on_load(1e-3, 0.0, extensors),
+                          _knee_controls_on_load(0.0, 0.0, extensors))
+    assert np.array_equal(_knee_controls_on_load(1e-3, 300.0, 0.0),
+                          _knee_controls_on_load(0.0, 300.0, 0.0))
+
 def _first_controls(params, a, t_s, sigma0=False):
     """The controls of a fresh controller's first call at t_s (s) on the lifted body: the
     features are still their prior (sigma0: the extensors' synchrony set to 0 instead), so

@@ -34,15 +34,18 @@ SHARED = ("ankle_gain", "e_on", "w_flex", "w_cross", "contact_hold", "lift_abort
 BLENDED = ("k_ax", "k_av", "kp_t", "kd_t", "pitch_d", "theta0", "c_v", "c_d", "kp_sw", "kd_sw",
            "kf_t", "knee_ext", "knee_crouch", "knee_swing", "knee_land", "kp_knee", "kp_push",
            "kp_air", "kd_knee", "push", "swing_rest", "x_clear", "push_off", "knee_hold",
-           "land_yield", "x_bal", "lean_knee", "toe_up", "capture_place", "capture_ankle")
+           "land_yield", "x_bal", "lean_knee", "toe_up", "capture_place", "capture_ankle",
+           "force_fb")
 # Gains added after gains files had been written, with the value that reproduces the
 # controller before them (a file without them reads as that value; cpgbiped.envs.control).
 ADDED_NEUTRAL = {"push_off": 0.0, "knee_hold": 0.0, "land_yield": 0.0, "x_bal": 0.0,
-                 "lean_knee": 0.0, "toe_up": 0.0, "capture_place": 0.0, "capture_ankle": 0.0}
+                 "lean_knee": 0.0, "toe_up": 0.0, "capture_place": 0.0, "capture_ankle": 0.0,
+                 "force_fb": 0.0}
 ADDED_NEUTRAL_SHARED = {"lift_abort": 0.0, "restart_v": 0.0, "sync_land": 0.0, "pitch_tau_s": 0.0}
 # ... of those, the ones added after the start-up corners were (a start-up corner at their
 # neutral value hashes as before them: envs.search.controller_tuning.params_sha256).
-ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up", "capture_place", "capture_ankle")
+ADDED_AFTER_STARTUP = ("x_bal", "lean_knee", "toe_up", "capture_place", "capture_ankle",
+                       "force_fb")
 CORNERS = ("alternating", "alternating_coactive", "synchronous", "synchronous_coactive")
 N_SHARED = len(SHARED)
 P_SIZE = N_SHARED + 4 * len(BLENDED)
@@ -261,10 +264,10 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     (k_ax, k_av, kp_t, kd_t, pitch_d, theta0, c_v, c_d, kp_sw, kd_sw, kf_t, knee_ext,
      knee_crouch, knee_swing, knee_land, kp_knee, kp_push, kp_air, kd_knee, push,
      swing_rest, x_clear, push_off, knee_hold, land_yield, x_bal, lean_knee, toe_up,
-     capture_place, capture_ankle) = (
+     capture_place, capture_ankle, force_fb) = (
         G[0], G[1], G[2], G[3], G[4], G[5], G[6], G[7], G[8], G[9], G[10], G[11], G[12], G[13],
         G[14], G[15], G[16], G[17], G[18], G[19], G[20], G[21], G[22], G[23], G[24], G[25],
-        G[26], G[27], G[28], G[29])
+        G[26], G[27], G[28], G[29], G[30])
     push_off = max(0.0, push_off)
     knee_hold = _clip01(knee_hold)
     land_yield = _clip01(land_yield)
@@ -462,6 +465,8 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
             if i == trailing and not side_by_side and knee[i] > target:
                 target += knee_hold * (knee[i] - target)
             k = kp * (target - knee[i]) - kd_knee * knee_rate[i] + push * drive
+            if force_fb != 0.0:  # positive force feedback: the load extends, in the burst
+                k += force_fb * drive * abs(sens[ix[IX_FORCE + i]])
         else:
             # the swing drive tucks the leg while its foot is behind the hip (clearance); once
             # the foot is x_clear ahead of it the knee extends to land

@@ -116,11 +116,12 @@ CORNER_RANGES = dict(
     kp_knee=(0.3, 5.0), kp_push=(0.1, 5.0), kp_air=(0.3, 5.0), kd_knee=(0.02, 0.3),
     push=(0.0, 1.0), swing_rest=(0.0, 1.0), x_clear=(-0.2, 0.3), push_off=(0.0, 0.6),
     knee_hold=(0.0, 1.0), land_yield=(0.0, 1.0), x_bal=(-0.05, 0.10), lean_knee=(0.0, 1.5),
-    toe_up=(0.0, 1.0), capture_place=(0.0, 30.0), capture_ankle=(0.0, 1.0))
+    toe_up=(0.0, 1.0), capture_place=(0.0, 30.0), capture_ankle=(0.0, 1.0),
+    force_fb=(0.0, 0.01))
 # Gains added after the stages of scripts/tune_gains.sh that search every gain were run: a
 # search takes them only when --only names them, so that those stages reproduce.
 OPT_IN = ("land_yield", "lift_abort", "restart_v", "x_bal", "lean_knee", "toe_up", "sync_land",
-          "pitch_tau_s", "capture_place", "capture_ankle")
+          "pitch_tau_s", "capture_place", "capture_ankle", "force_fb")
 # ... and of the shared parameters.
 SHARED_RANGES = dict(ankle_gain=(0.05, 0.35), e_on=(0.3, 0.7), w_flex=(0.0, 1.5),
                      w_cross=(0.0, 1.5), contact_hold=(0.0, 0.06), lift_abort=(0.0, 1.0),
