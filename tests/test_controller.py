@@ -32,6 +32,17 @@ def synthetic(a: np.ndarray) -> CPGSchedule:
     return CPGSchedule(np.ascontiguousarray(a), np.ascontiguousarray(a), DT)
 
 
+def at_every_corner(start_up=True, **gains):
+    """The committed gains with ``gains`` set at all four corners (start_up=False: without the
+    start-up gains, so that the corners act from the first tick)."""
+    from dataclasses import replace
+
+    p = CONTROL
+    for c in K.CORNERS:
+        p = p.with_corner(c, **gains)
+    return p if start_up else replace(p, startup=None)
+
+
 def square(t, period, shift, duty=0.4):
     return (((t / period) - shift) % 1.0 < duty).astype(float)
 
@@ -210,8 +221,8 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     1-5 s the knee gives 0.0065 and 0.0079 rad (18 and 30 landings), not twice as far. What
     this measures is the rollout's give, not the gate at one landing: of the 9 and 14
     landings counted here most come outside the extensor burst, where the yield does not act
-    directly, and over the landings inside it the give is 0.0036 and 0.0013 rad (session 50); the gate
-    itself is tested on the lifted body below."""
+    directly, and over the landings inside it the give is 0.0036 and 0.0013 rad (session 50);
+    the gate itself is tested on the lifted body below."""
     from dataclasses import replace
 
     from cpgbiped.envs.simulation.rollout import rollout
@@ -257,12 +268,7 @@ def _knee_controls_through_a_landing(land_yield):
     the lifted body, both extensors bursting (land_yield at every corner, no start-up gains):
     in the air at 1.000 s, then counted on the ground (their last contact at this tick) with
     the knees flexing at 2 and 1 rad/s, then still (0) and extending (0.5 rad/s)."""
-    from dataclasses import replace
-
-    p = CONTROL
-    for c in K.CORNERS:
-        p = p.with_corner(c, land_yield=land_yield)
-    p = replace(p, startup=None)
+    p = at_every_corner(start_up=False, land_yield=land_yield)
     m, d = lifted_body()
     a = np.zeros((2000, 4))
     a[:, 2:] = 1.0
@@ -283,8 +289,8 @@ def test_landing_yield_gate_withholds_the_drive_only_while_the_knee_flexes():
     its extensor burst is armed in the air (yield state 1), yields while its knee flexes
     (state 2: the burst's knee drive withheld by land_yield, so that with land_yield 1 the
     knee extends less than with 0), and takes up the drive once the flexion stops (state 0:
-    the same controls as with land_yield 0, to the bit, while flexing and after). Checked on
-    both legs, which land together."""
+    the same controls as with land_yield 0, to the bit, once the knee is still and while it
+    extends). Checked on both legs, which land together."""
     off, on = _knee_controls_through_a_landing(0.0), _knee_controls_through_a_landing(1.0)
     assert list(on[0][1]) == [K.MODE_AIR] * 2 and list(on[0][2]) == [1.0, 1.0]
     assert np.array_equal(on[0][0], off[0][0])  # in the air the yield does nothing
@@ -295,17 +301,13 @@ def test_landing_yield_gate_withholds_the_drive_only_while_the_knee_flexes():
         assert list(on[k][2]) == [0.0, 0.0]
         assert np.array_equal(on[k][0], off[k][0]), (k, on[k][0], off[k][0])
 
+
 def _knee_controls_on_load(force_fb, load_n, extensors=1.0):
     """Both knees' controls at the second call of a fresh controller on the lifted body, both
     feet counted on the ground (their last contact at this tick), both extensors at the given
     activation and the flexors silent, each foot's contact sensor reading load_n newtons
     (force_fb at every corner, no start-up gains)."""
-    from dataclasses import replace
-
-    p = CONTROL
-    for c in K.CORNERS:
-        p = p.with_corner(c, force_fb=force_fb)
-    p = replace(p, startup=None)
+    p = at_every_corner(start_up=False, force_fb=force_fb)
     m, d = lifted_body()
     a = np.zeros((2000, 4))
     a[:, 2:] = extensors
@@ -323,17 +325,21 @@ def _knee_controls_on_load(force_fb, load_n, extensors=1.0):
 def test_force_feedback_adds_the_load_times_the_burst_to_the_knee(extensors):
     """force_fb (gear per N; the controller's docstring, 5): on a support leg the knee's
     extension torque grows by force_fb x drive x |F|, F the foot's contact force: with 300 N on
-    each foot and force_fb 1e-3, by 0.3 x the extensor's activation (the drive of a leg that
-    has not taken off in this burst), on both knees; at 0 N, or at force_fb 0, by nothing
-    (to the bit); and outside the burst (extensors silent) by nothing either."""
+    each foot (either sign: the sensor's normal force) and force_fb 1e-3, by 0.3 x the
+    extensor's activation (the drive of a leg that has not taken off in this burst), on both
+    knees; at 0 N by nothing (to the bit), and outside the burst (extensors silent) by nothing
+    either. (force_fb 0 reproducing the controller before it: tests/test_feedback.py's
+    recorded rows.)"""
     base = _knee_controls_on_load(0.0, 300.0, extensors)
     fed = _knee_controls_on_load(1e-3, 300.0, extensors)
-    assert np.all(base < 0.6)  # room under the clip at 1, so that the sum is not cut
+    assert np.all((base < 0.6) & (base > -0.7))  # inside the clip at +-1, so the sum is not cut
     assert fed == pytest.approx(base + 0.3 * extensors, abs=1e-9)
+    assert np.array_equal(_knee_controls_on_load(1e-3, -300.0, extensors), fed)
     assert np.array_equal(_knee_controls_on_load(1e-3, 0.0, extensors),
                           _knee_controls_on_load(0.0, 0.0, extensors))
     assert np.array_equal(_knee_controls_on_load(1e-3, 300.0, 0.0),
                           _knee_controls_on_load(0.0, 300.0, 0.0))
+
 
 def _first_controls(params, a, t_s, sigma0=False):
     """The controls of a fresh controller's first call at t_s (s) on the lifted body: the
@@ -811,12 +817,6 @@ def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, v
     so that the blend is 1) a foot tilted onto its toes (heel) in the world, past 0.15 rad,
     gets none of it: its muscles get what they get with the reflex's gains k_ax = k_av = 0 (the
     CPG's drive and the push-off); a flat foot all of it, whatever its ankle joint's angle."""
-    def every_corner(**gains):
-        p = CONTROL
-        for c in K.CORNERS:
-            p = p.with_corner(c, **gains)
-        return p
-
     from cpgbiped.envs.control.controller import kernel_index
 
     u0, m, d = _jump_controls(CONTROL, ankle_rad, vx, False, crouch)
@@ -825,8 +825,8 @@ def test_capture_ankle_withholds_the_reflex_from_a_foot_on_its_toes(ankle_rad, v
         assert (abs(K.foot_angle(d.qpos, ix, i)) > K.CAPTURE_TILT_RAD) == (ankle_rad != 0.0
                                                                          and not crouch)
     assert np.sign(_beyond(m, d)) == np.sign(vx)  # the XcoM has left the feet in every case
-    u1, _, _ = _jump_controls(every_corner(capture_ankle=1.0), ankle_rad, vx, False, crouch)
-    u_none, _, _ = _jump_controls(every_corner(k_ax=0.0, k_av=0.0), ankle_rad, vx, False, crouch)
+    u1, _, _ = _jump_controls(at_every_corner(capture_ankle=1.0), ankle_rad, vx, False, crouch)
+    u_none, _, _ = _jump_controls(at_every_corner(k_ax=0.0, k_av=0.0), ankle_rad, vx, False, crouch)
     muscles = slice(2, 4) if vx > 0 else slice(0, 2)  # b > 0: extensors; b < 0: flexors
     assert np.all(u0[muscles] > u_none[muscles] + 0.5)  # the reflex acts without the response
     if withheld:

@@ -86,9 +86,9 @@ KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
     # a little): the hop on friction x2.0 is named a jump, its ankle at the split's edge (29.6
     # deg before); in 0 of 21 re-rolls of the gains by nothing physical, against 15 of 21
     # before (scripts/condition_coins.py); over unused CPG states 7120-7169 the hop keeps
-    # friction x2.0 in 14 of 50 either way, over 7250-7349 in 39 of 100 (scripts/rule_rates.py;
-    # the hop corner's weaker balance reflex of rule S kept it in 92 of those 100 but was not
-    # adopted: journal, session 51)
+    # friction x2.0 in 14 of 50 either way, over 7250-7349 in 39 of 100 and over 7380-7479 in 40
+    # (scripts/rule_rates.py; the hop corner's weaker balance reflex of rules S and T kept it in
+    # 92 and 88 of those 100 but was not adopted: journal, session 51)
     "hop-friction2.0": ("named a jump: its ankle turns 31.0 deg in stance, the split's 30",
                         False),
 }

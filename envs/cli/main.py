@@ -1442,7 +1442,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "that --gait and --search select; a name may be one corner's "
                          "(synchronous.theta0) or all of it (synchronous.*), so that "
                          "--gait walk,jump --only 'synchronous.*' searches the jump's corner "
-                         "scored on both gaits; land_yield, x_bal, lean_knee, toe_up, lift_abort, restart_v, sync_land and pitch_tau_s are "
+                         "scored on both gaits; land_yield, x_bal, lean_knee, toe_up, capture_place, capture_ankle, force_fb, lift_abort, restart_v, sync_land and pitch_tau_s are "
                          "searched only when named here; startup.<corner>.<gain> or startup.<corner>.* searches "
                          "the start-up gains that hand over to the corners in the first "
                          "seconds (every gait starts on them)")

@@ -119,10 +119,10 @@ Per control tick (every ``control_every`` physics steps; ctrl held in between):
        tau = kp (target - q) - kd_knee q_rate + push d_i + force_fb d_i |F_i|
        (the extensor burst extends the leg - the push-off; outside it the knee yields to a
        crouch that absorbs the landing and loads the next push). force_fb (gear per N; 0
-       reproduces the controller before it): positive force feedback, the foot's contact
-       force F_i (the contact sensor's normal force, N) adding to the extension while the
-       burst lasts: a load reflex gated by the CPG's extensor burst, the extensors' positive
-       force feedback that makes a bounce self-sustaining in models of hopping (Geyer,
+       reproduces the controller before it): the foot's contact force F_i (the contact
+       sensor's normal force, N) adding to the extension while the burst lasts: a load reflex
+       gated by the CPG's extensor burst, the extensors' positive force feedback that makes a
+       bounce self-sustaining in models of hopping (Geyer,
        Seyfarth & Blickhan 2003) and that cats show in stance (Prochazka et al. 1997); it
        adds to the cells' drive and never acts outside their burst. After a landing the drive
        is d_i (1 - land_yield) until the knee's flexion stops (knee rate >= 0 after flexing):
@@ -224,8 +224,8 @@ class Corner:
     # mass beyond two feet side by side (docstring, 4)
     capture_ankle: float  # share (0-1) of the balance reflex withheld from a foot on its toes
     # (heel) once that centre of mass is past them (docstring, 3)
-    force_fb: float = 0.0  # knee extension (gear) per N of the foot's contact force, in
-    # the extensor burst: positive force feedback (docstring, 5)
+    force_fb: float  # knee extension (gear) per N of the foot's contact force, in the
+    # extensor burst: positive force feedback (docstring, 5)
 
 
 @dataclass(frozen=True)

@@ -117,7 +117,7 @@ CORNER_RANGES = dict(
     push=(0.0, 1.0), swing_rest=(0.0, 1.0), x_clear=(-0.2, 0.3), push_off=(0.0, 0.6),
     knee_hold=(0.0, 1.0), land_yield=(0.0, 1.0), x_bal=(-0.05, 0.10), lean_knee=(0.0, 1.5),
     toe_up=(0.0, 1.0), capture_place=(0.0, 30.0), capture_ankle=(0.0, 1.0),
-    force_fb=(0.0, 0.01))
+    force_fb=(0.0, 0.002))
 # Gains added after the stages of scripts/tune_gains.sh that search every gain were run: a
 # search takes them only when --only names them, so that those stages reproduce.
 OPT_IN = ("land_yield", "lift_abort", "restart_v", "x_bal", "lean_knee", "toe_up", "sync_land",
