@@ -263,16 +263,21 @@ def test_landing_yield_lets_the_knee_give_before_it_pushes():
     assert give[0.0] < 0.02 and give[1.0] > 2.0 * give[0.0], give
 
 
+def _extensors_bursting(params, level):
+    """(model, data, a fresh controller) on the lifted body, both extensor cells at activation
+    ``level`` and both flexors silent for 4 s."""
+    m, d = lifted_body()
+    a = np.zeros((2000, 4))
+    a[:, 2:] = level
+    return m, d, CPGController(m, d, synthetic(a), params=params)
+
+
 def _knee_controls_through_a_landing(land_yield):
     """Both knees' controls, modes and yield states over five calls of a fresh controller on
     the lifted body, both extensors bursting (land_yield at every corner, no start-up gains):
     in the air at 1.000 s, then counted on the ground (their last contact at this tick) with
     the knees flexing at 2 and 1 rad/s, then still (0) and extending (0.5 rad/s)."""
-    p = at_every_corner(start_up=False, land_yield=land_yield)
-    m, d = lifted_body()
-    a = np.zeros((2000, 4))
-    a[:, 2:] = 1.0
-    ctl = CPGController(m, d, synthetic(a), params=p)
+    m, d, ctl = _extensors_bursting(at_every_corner(start_up=False, land_yield=land_yield), 1.0)
     knees = [m.jnt_dofadr[m.joint(n).id] for n in ("left_knee", "right_knee")]
     rows = []
     for t, down, rate in ((1.000, False, 0.0), (1.004, True, -2.0), (1.008, True, -1.0),
@@ -307,11 +312,8 @@ def _knee_controls_on_load(force_fb, load_n, extensors=1.0):
     feet counted on the ground (their last contact at this tick), both extensors at the given
     activation and the flexors silent, each foot's contact sensor reading load_n newtons
     (force_fb at every corner, no start-up gains)."""
-    p = at_every_corner(start_up=False, force_fb=force_fb)
-    m, d = lifted_body()
-    a = np.zeros((2000, 4))
-    a[:, 2:] = extensors
-    ctl = CPGController(m, d, synthetic(a), params=p)
+    _, d, ctl = _extensors_bursting(at_every_corner(start_up=False, force_fb=force_fb),
+                                    extensors)
     for t in (1.000, 1.004):
         ctl.S[K.S_LAST_GROUND:K.S_LAST_GROUND + 2] = t
         for i in range(2):

@@ -1129,3 +1129,17 @@ def test_corner_search_keeps_the_best_point_it_scored(monkeypatch, tmp_path, cap
         k: v for k, v in base["startup"]["corners"].items() if k != corner}
     assert json.loads((tmp_path / "history.json").read_text()) == history
     assert "t: gen 2: best" in capsys.readouterr().out
+
+
+def test_tune_only_help_names_every_gain_searched_only_when_named():
+    """`cpgbiped tune --help` says which gains a search takes only when --only names them
+    (controller_tuning.OPT_IN); the help is written by hand (the parser does not import the
+    search), so every name of OPT_IN must appear in it (it had fallen two, then three, behind)."""
+    from cpgbiped.envs.cli.main import build_parser
+    from cpgbiped.envs.search.controller_tuning import OPT_IN
+
+    tune = next(a for a in build_parser()._subparsers._group_actions[0].choices.items()
+                if a[0] == "tune")[1]
+    only = next(a for a in tune._actions if "--only" in a.option_strings).help
+    missing = [g for g in OPT_IN if g not in only]
+    assert not missing, missing
