@@ -2,6 +2,7 @@
 phase response (issue 21)."""
 from __future__ import annotations
 
+import functools
 import json
 import os
 import subprocess
@@ -383,18 +384,65 @@ def test_the_envelope_takes_the_gains_it_is_given(monkeypatch):
 
 
 # -- what issue 21 asks and the closed loop does not reach (measured, README "Feedback") ----
+@functools.cache
+def _closed_loop_summary(gait, seed, friction_scale):
+    """The Morris-Lecar preset of ``gait`` with the recommended feedback, the 20 s after
+    settling (criteria.WINDOW_S), as ``validate --feedback`` measures it (cached per process)."""
+    from cpgbiped.envs.gaits.criteria import WINDOW_S
+    from cpgbiped.envs.gaits.validate import validate
+
+    return validate(build("ml", gait, seed=seed), gait, WINDOW_S, friction_scale=friction_scale,
+                    feedback=RECOMMENDED["ml"]).summary()
+
+
+def _closed_loop(gait, cond):
+    cond = dict(cond)
+    return _closed_loop_summary(gait, cond.pop("seed", None), cond.pop("friction_scale", 1.0))
+
+
+# Issue 21's first clause, measured with the recommended feedback (README "Status", issue 21's
+# row; scripts/report_feedback.py): case -> what was measured. Every miss sits at a criterion's
+# edge or is a single fall or a late regular start of a chaotic body, which a change far away
+# moves (non-strict, as tests/test_physics.py's).
+CLOSED_LOOP_SHORTFALLS = {
+    "walk-friction1.3": "Froude number 0.0799 against 0.08 (since session 50)",
+    "run-friction0.7": "the left leg's duty 0.299 against 0.30",
+    "hop-seed18": "stride CV 0.13: its strides regular only from 5.5 s",
+    "hop-friction1.3": "falls at 9.9 s (since session 50)",
+}
+
+
+def _closed_loop_cases():
+    from tests.test_physics import CONDITION_IDS, CONDITIONS, GAITS
+
+    for gait in GAITS:
+        for cond, cid in zip(CONDITIONS, CONDITION_IDS):
+            why = CLOSED_LOOP_SHORTFALLS.get(f"{gait}-{cid}")
+            marks = [pytest.mark.xfail(strict=False, raises=AssertionError, reason=why)
+                     ] if why else []
+            yield pytest.param(gait, cond, marks=marks, id=f"{gait}-{cid}")
+
+
+@pytest.mark.parametrize("gait,cond", list(_closed_loop_cases()))
+def test_every_preset_meets_its_criteria_with_feedback(gait, cond):
+    """Issue 21: with feedback at the recommended gain every Morris-Lecar preset still passes
+    every criterion of its gait in each of the 13 test conditions (as
+    tests/test_physics.py asks open loop; the hop's cadence against the jump's, both closed
+    loop), the CPG classifier's name from the closed-loop cells among them."""
+    from cpgbiped.envs.gaits.criteria import CRITERIA
+
+    s = _closed_loop(gait, cond)
+    ref = CRITERIA[gait].cadence_above
+    failures = CRITERIA[gait].failures(s, {ref: _closed_loop(ref, cond)} if ref else {})
+    assert not failures, failures  # the criteria include the CPG classifier's name
+
+
 def test_the_jump_survives_the_test_conditions_with_feedback():
     """Issue 21: with feedback at the recommended gain the jump preset does not fall in any of
     the 13 test conditions (22 s each)."""
     from tests.test_physics import CONDITIONS
 
-    fell = 0
-    for cond in CONDITIONS:
-        cond = dict(cond)
-        rec = rollout(build("ml", "jump", seed=cond.pop("seed", None)), 22.0, poses=False,
-                      feedback=RECOMMENDED["ml"], **cond)
-        fell += rec.fell_at is not None
-    assert fell == 0
+    assert [bool(_closed_loop("jump", c)["fell"]) for c in CONDITIONS] == [False] * 13
 
 
 # Measured 2026-12-04 (Table 3 state; smallest impulse survived over four stride phases, open
