@@ -34,6 +34,14 @@ better than open loop unless the numbers say so); when no candidate is admissibl
 smallest gain tried. Writes cpg/feedback_gains.json (read by cpg.feedback) with every
 candidate's rollouts and this command.
 
+The committed cpg/feedback_gains.json was made by the rule before session 52 (format 1: four
+seeds on friction x1.0), on the gains of session 40: the gated angle at K = 0.03. Re-run on the
+gains of session 52 this rule picks the gated angle at K = 0.02 (225 N s), which rule V did not
+adopt: it makes the run pass on friction x0.7 (73 of 80 unused states against 9) but loses its
+backward push envelope (2.5 N s from the Table 3 state against 30) and in-family transitions
+(docs/JOURNAL.md, "Session 52"). Write a re-run elsewhere (--out) to compare before replacing
+the committed file; tests/test_feedback.py re-applies the rule of the file's format.
+
     python3 scripts/feedback_choice.py [--push-s 0.2] [--workers 2]
                                        [--out cpg/feedback_gains.json]     (about 25 minutes)
 """
