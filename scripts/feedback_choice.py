@@ -122,7 +122,7 @@ def costs(rows, open_rows) -> list[str]:
         pairs = [(r, ref[(p, r["cpg_seed"], fr)]) for r in rows
                  if r["preset"] == p and r["friction"] == fr]
         for what, good in (("passes", lambda r, o: r["criteria_passed"]),
-                           ("falls", lambda r, o: not r["fell"]),
+                           ("standing", lambda r, o: not r["fell"]),
                            ("CPG names", lambda r, o: r["cpg_gait"] == o["cpg_gait"])):
             cand = [good(r, o) for r, o in pairs]
             base = [good(o, o) for r, o in pairs]

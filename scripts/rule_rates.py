@@ -49,8 +49,12 @@ declared, not run), 6860-6989 rule O, the run's start-up corner (the presets 686
 6990-7089; 7090-7119 declared, not run); 7120-7249 rule Q, the run corner's stance knee (the
 presets 7120-7219, the transitions 7220-7249; session 50); 7250-7379 rule S, the hop corner's
 balance reflex (the presets 7250-7349, the transitions 7350-7379), 7380-7509 rule T, the same
-with positive force feedback (the presets 7380-7479, the transitions 7480-7509; session 51).
-Unused: 7510 and up.
+with positive force feedback (the presets 7380-7479, the transitions 7480-7509; session 51);
+7510-7629 rule U, the touchdown pulse as the recommended feedback (the presets 7510-7589, the
+envelopes 7590-7599, the transitions 7600-7629), 7630-7769 rule V, the gated angle at K = 0.02
+(the presets 7630-7709, the envelopes 7710-7719, the transitions 7720-7749, the Matsuoka walk
+7750-7769; session 52).
+Unused: 7770 and up.
 The tests' and the tuning's states are refused; a bank an earlier rule used is counted with a
 note (re-counting that rule is what it is for then).
 """
@@ -76,7 +80,7 @@ USED_BANKS = ((2000, 2099), (2100, 2147), (2200, 2349), (2350, 2379), (2400, 241
               (5580, 5759), (5760, 5779), (5780, 5909), (5910, 6039), (6040, 6169),
               (6170, 6369), (6370, 6469), (6470, 6599), (6600, 6729), (6730, 6859),
               (6860, 6989), (6990, 7119), (7120, 7249), (7250, 7379),
-              (7380, 7509))
+              (7380, 7509), (7510, 7629), (7630, 7769))
 
 
 def one(job):

@@ -1143,3 +1143,31 @@ def test_tune_only_help_names_every_gain_searched_only_when_named():
     only = next(a for a in tune._actions if "--only" in a.option_strings).help
     missing = [g for g in OPT_IN if g not in only]
     assert not missing, missing
+
+
+def test_feedback_choice_admits_a_candidate_by_paired_counts_on_each_floor():
+    """scripts/feedback_choice.py (since session 52): a candidate is admissible when, per
+    preset and floor, it loses no more than 2 sqrt(b + c) net pairs against open loop's
+    rollouts from the same states (b lost, c gained), in passes, in standing and in the CPG's
+    name. Counted by hand: losing 4 of 20 passes with none gained is 4 <= 2 sqrt(4) = 4,
+    admissible; losing 5 is 5 > 2 sqrt(5) = 4.47, not; losing 16 on one floor (the gated angle
+    at K = 0.03 on friction x0.7, the run) is not, whatever the other floors do; 6 lost and
+    6 gained is 0 net, admissible."""
+    fc = _script("feedback_choice")
+    assert fc.no_worse([False] * 4 + [True] * 16, [True] * 20)
+    assert not fc.no_worse([False] * 5 + [True] * 15, [True] * 20)
+    assert fc.no_worse([False] * 6 + [True] * 14, [True] * 6 + [False] * 6 + [True] * 8)
+
+    def row(seed, friction, passed, fell=False, gait="run", gain=0.03):
+        return {"preset": "run", "cpg_seed": seed, "friction": friction, "gain": gain,
+                "criteria_passed": passed, "fell": fell, "cpg_gait": gait}
+
+    open_rows = [row(s, f, True, gain=0.0) for f in (1.0, 0.7) for s in range(20)]
+    good = [row(s, 1.0, True) for s in range(20)]
+    slippery = [row(s, 0.7, s >= 16) for s in range(20)]  # 16 passes lost on x0.7
+    assert fc.costs(good + [row(s, 0.7, True) for s in range(20)], open_rows) == []
+    assert fc.costs(good + slippery, open_rows) == ["run x0.7 passes 4/20 (open loop 20)"]
+    renamed = [row(s, 0.7, True, gait="none" if s < 5 else "run") for s in range(20)]
+    assert fc.costs(good + renamed, open_rows) == ["run x0.7 CPG names 15/20 (open loop 20)"]
+    fallen = [row(s, 0.7, True, fell=s < 5) for s in range(20)]
+    assert fc.costs(good + fallen, open_rows) == ["run x0.7 standing 15/20 (open loop 20)"]
