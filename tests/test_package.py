@@ -69,3 +69,38 @@ def test_the_readme_layout_names_every_module():
     for mod in (ROOT / "cpg").glob("*.py"):
         if not mod.name.startswith("__"):
             assert mod.name in layout or mod.stem in layout, mod.name
+
+
+def test_numba_caches_live_in_a_directory_named_by_the_sources(tmp_path):
+    """numba keys a cached kernel on its own file only, so a kernel inlining another module's
+    function ran that function's old code after it changed (session 52). cpgbiped names the
+    cache directory by a hash of every source file: an edit anywhere (not a __pycache__ file)
+    moves it, and a process that imports the package compiles into it unless the user set
+    NUMBA_CACHE_DIR."""
+    import os
+
+    import cpgbiped
+
+    tree = tmp_path / "cpg"
+    (tree / "__pycache__").mkdir(parents=True)
+    (tree / "a.py").write_text("x = 1\n")
+    (tree / "b.py").write_text("y = 2\n")
+    before = cpgbiped._source_hash([tree])
+    (tree / "__pycache__" / "a.cpython-311.pyc").write_bytes(b"\0")
+    assert cpgbiped._source_hash([tree]) == before  # compiled files do not count
+    (tree / "b.py").write_text("y = 3\n")
+    assert cpgbiped._source_hash([tree]) != before
+    (tree / "b.py").write_text("y = 2\n")
+    assert cpgbiped._source_hash([tree]) == before
+
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    check = "print(numba.config.CACHE_DIR == cpgbiped._numba_cache_dir())"
+    for imports in ("import numba, cpgbiped", "import cpgbiped, numba"):  # numba first, or after
+        out = subprocess.run([sys.executable, "-c", f"{imports}; {check}"], capture_output=True,
+                             text=True, env=env, cwd=tmp_path, check=True)
+        assert out.stdout.strip() == "True", out.stderr
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "mine")
+    out = subprocess.run([sys.executable, "-c", "import cpgbiped, numba; "
+                          "print(numba.config.CACHE_DIR)"], capture_output=True, text=True,
+                         env=env, cwd=tmp_path, check=True)
+    assert out.stdout.strip() == str(tmp_path / "mine")
