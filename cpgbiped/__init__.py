@@ -24,8 +24,8 @@ def _source_hash(dirs) -> str:
 
     h = hashlib.sha256()
     for top in dirs:
-        for base, subdirs, files in sorted(_os.walk(top)):
-            subdirs[:] = sorted(d for d in subdirs if d != "__pycache__")
+        for base, subdirs, files in _os.walk(top):
+            subdirs[:] = sorted(d for d in subdirs if d != "__pycache__")  # walked in this order
             for name in sorted(f for f in files if f.endswith(".py")):
                 path = _os.path.join(base, name)
                 h.update(_os.path.relpath(path, top).encode() + b"\0")
@@ -34,35 +34,50 @@ def _source_hash(dirs) -> str:
     return h.hexdigest()[:16]
 
 
+def _kernel_dirs() -> list:
+    """The folders of the subpackages that hold numba kernels (cpg/, envs/): beside this
+    package in a source tree, inside it in an installed wheel (as ``__path__`` above)."""
+    base = _here if _os.path.isdir(_os.path.join(_here, "cpg")) else _root
+    return [_os.path.join(base, sub) for sub in ("cpg", "envs")
+            if _os.path.isfile(_os.path.join(base, sub, "__init__.py"))]
+
+
 def _numba_cache_dir() -> str:
     """Where numba keeps the compiled kernels (``@njit(cache=True)``): a directory named by a
     hash of the package's sources. numba keys each cached function on its own file's time stamp
     only, so a kernel that inlines another module's function (envs/control/control_kernel.py's
-    tick calls cpg/feedback.py's ``inputs``) would keep running the old code after that module
-    changed (measured in session 52: a new feedback form ran as another form until the caches
-    were deleted). A changed source gives a fresh directory; ``NUMBA_CACHE_DIR`` set by the
-    user is kept."""
-    dirs = [_os.path.join(d, sub) for d in (_here, _root) for sub in ("cpg", "envs")
-            if _os.path.isfile(_os.path.join(d, sub, "__init__.py"))]
+    tick calls cpg/feedback.py's ``inputs``) or reads its constants would keep running the old
+    code after that module changed (measured in session 52: a new feedback form ran as another
+    form until the caches were deleted). A changed source gives a fresh directory, under the
+    user's cache folder, or the temporary folder when that cannot be written."""
+    import tempfile
+
+    name = _os.path.join("cpgbiped", "numba", _source_hash(_kernel_dirs()))
     base = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
-    return _os.path.join(base, "cpgbiped", "numba", _source_hash(dirs))
+    if _os.path.isabs(base):
+        path = _os.path.join(base, name)
+        try:
+            _os.makedirs(path, exist_ok=True)
+            if _os.access(path, _os.W_OK):
+                return path
+        except OSError:
+            pass
+    return _os.path.join(tempfile.gettempdir(), name)
 
 
 def _use_numba_cache_dir() -> None:
-    """Point numba at :func:`_numba_cache_dir` unless the user chose a directory or it cannot
-    be written (then numba's own default, beside the sources, as before)."""
+    """Point numba at :func:`_numba_cache_dir`, unless the user chose NUMBA_CACHE_DIR (a value
+    this package set, inherited by a child process, is recomputed: the sources may have changed
+    since the parent started) or no kernel folder is found (then numba's default)."""
     import sys
 
-    if "NUMBA_CACHE_DIR" in _os.environ:
+    ours = _os.environ.get("CPGBIPED_NUMBA_CACHE_DIR")
+    if "NUMBA_CACHE_DIR" in _os.environ and _os.environ["NUMBA_CACHE_DIR"] != ours:
+        return
+    if not _kernel_dirs():
         return
     path = _numba_cache_dir()
-    try:
-        _os.makedirs(path, exist_ok=True)
-    except OSError:
-        return
-    if not _os.access(path, _os.W_OK):
-        return
-    _os.environ["NUMBA_CACHE_DIR"] = path
+    _os.environ["NUMBA_CACHE_DIR"] = _os.environ["CPGBIPED_NUMBA_CACHE_DIR"] = path
     if "numba" in sys.modules:  # numba read its configuration already
         sys.modules["numba"].config.CACHE_DIR = path
 

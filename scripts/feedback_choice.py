@@ -1,49 +1,57 @@
 """Choose each network's feedback pathway and recommended gain by measurement.
 
-Candidates: the Morris-Lecar forms of cpg.feedback (load into the extensors, load into
-extensors and flexors, Taga's gated thigh angle, a touchdown pulse, Taga's angle in
-alternating rhythms only), Hopf Tegotae, Matsuoka Taga; each at a few gains K. For each
-candidate and each preset of the network (Morris-Lecar: all four; Hopf: walk and run, its jump
-falls open loop; Matsuoka: its walk), on **tuning conditions only** (CPG seeds 1000-1019; the
-tests use the Table 3 state and CPG seeds 10-19):
-- feedback must not cost the gait, on the kinds of floor the tests use (since session 52): the
-  unperturbed closed-loop rollouts (22 s) from ADMIT_SEEDS on friction x1.0, x0.7 and x1.3
-  (ADMIT_FRICTIONS), paired with the open-loop rollouts from the same state and floor, per
-  preset and floor: the rollouts that pass every criterion of the preset's gait
-  (envs.gaits.criteria, the 20 s after settling; the criteria include the CPG classifier's
-  name from the closed-loop cells), those that fall, and those whose closed-loop CPG is named
-  otherwise than open loop's, each no worse than open loop's by more than the noise of a paired
-  count, 2 sqrt(b + c) (b the pairs the candidate loses, c those it gains: the allowance of the
-  adoption rules, McNemar's statistic at two standard deviations). Before session 52 it asked
-  four seeds on friction x1.0 only, every rollout without a fall and with open loop's name and
-  as many passes per preset as open loop; on the gains of sessions 44-51 that admitted the
-  touchdown pulse at K = 0.05, which over 80 unused states loses the walk on friction x0.7 in
-  51 (rule U, docs/JOURNAL.md "Session 52"), and the gated angle at K = 0.03, which loses the
-  run on x0.7 in 16 of 20 tuning states. (Added 2026-12-04: the push score alone chose the load
-  into extensors and flexors at K = 0.03, whose walk then passed in 1 of the 13 test
-  conditions and its run in none; the Morris-Lecar jump and hop since session 40: the walk and
-  the run alone admitted the thigh angle, which cost the hop.)
-- score: the sum over the alternating presets (walk and run) and CHOICE_SEEDS (1000-1003, on
-  friction x1.0) of the smallest impulse survived over the four push phases in the stride after
-  5.5 s, forwards plus backwards (envs.robustness.push_envelope; the reported envelope of
-  ``cpgbiped robustness`` uses the preset's own state and pushes after 6 s); the other rows
-  carry 0 and are marked "scored": false.
+Candidates (the form strings of cpg.feedback.ML_FORMS): the Morris-Lecar "load" (the leg's
+load into its extensor), "load_antagonist" (the same and its opposite into the flexor),
+"angle" (Taga's contact-gated thigh angle), "reset" (a touchdown pulse) and
+"angle_alternating" (the thigh angle in alternating rhythms only, scaled by 1 - sigma); Hopf
+Tegotae; Matsuoka Taga; each at a few gains K. For each candidate and each preset of the
+network (Morris-Lecar: all four; Hopf: walk and run, its jump falls open loop; Matsuoka: its
+walk), on **tuning conditions only**, CPG seeds and floors that no test uses (the tests: the
+Table 3 state and CPG seeds 10-19, friction x0.7, x1.3, and x0.5 and x2.0 as perturbations):
+- feedback must not cost the gait (since session 52 on several floors): the unperturbed
+  closed-loop rollouts (22 s) from ADMIT_SEEDS (1000-1019) on each floor of ADMIT_FRICTIONS
+  (x1.0 and the controller tuning's x0.6, x0.8, x1.25, x1.6), each paired with the open-loop
+  rollout from the same state and floor; per preset and floor, with b the pairs the candidate
+  loses and c those it gains:
+    passing every criterion of the preset's gait (envs.gaits.criteria, the 20 s after
+    settling; the criteria include the CPG classifier's name from the closed-loop cells):
+    b - c <= 2 sqrt(b + c), the noise of a paired count at two standard deviations
+    (McNemar's statistic; the adoption rules' allowance);
+    standing (no fall) and the CPG classifier naming what it names open loop: b - c <= 1
+    (NEW_LOSSES_MAX: a fall or a renamed rhythm is not noise to be allowed by the handful).
+  Before session 52 it asked four seeds on friction x1.0 only: every rollout without a fall
+  and with open loop's name, and per preset as many passes as open loop; on the gains of
+  session 52 that admitted the touchdown pulse at K = 0.05, which over 80 unused states loses
+  the walk on friction x0.7 in 51 (rule U, docs/JOURNAL.md "Session 52"), and the
+  gated angle at K = 0.03, which loses the run on x0.7 in 16 of 20 tuning states. (Added
+  2026-12-04: the push score alone chose the load into extensors and flexors at K = 0.03,
+  whose walk then passed in 1 of the 13 test conditions and its run in none; the Morris-Lecar
+  jump and hop since session 40: the walk and the run alone admitted the thigh angle, which
+  cost the hop.)
+- score: the sum over the alternating presets (SCORED: walk and run) and CHOICE_SEEDS
+  (1000-1003, on friction x1.0) of the smallest impulse survived over the four push phases in
+  the stride after 5.5 s, forwards plus backwards (envs.robustness.push_envelope; the reported
+  envelope of ``cpgbiped robustness`` uses the preset's own state and pushes after 6 s); the
+  other rows carry 0 and are marked "scored": false.
 The recommended gain is the best-scoring admissible candidate with K > 0 (the open loop's
 score is printed beside it: feedback is recommended only as "the best closed loop", not as
 better than open loop unless the numbers say so); when no candidate is admissible, the
-smallest gain tried. Writes cpg/feedback_gains.json (read by cpg.feedback) with every
-candidate's rollouts and this command.
+smallest gain tried. Writes a feedback-choice file (format 2: every candidate's rollouts, the
+seeds, floors and allowance of the rule, and this command) to --out, by default
+out/feedback_choice/feedback_gains.json: cpg/feedback_gains.json, which cpg.feedback reads,
+is replaced only by copying a file that an adoption rule accepted.
 
 The committed cpg/feedback_gains.json was made by the rule before session 52 (format 1: four
-seeds on friction x1.0), on the gains of session 40: the gated angle at K = 0.03. Re-run on the
-gains of session 52 this rule picks the gated angle at K = 0.02 (225 N s), which rule V did not
-adopt: it makes the run pass on friction x0.7 (73 of 80 unused states against 9) but loses its
-backward push envelope (2.5 N s from the Table 3 state against 30) and in-family transitions
-(docs/JOURNAL.md, "Session 52"). Write a re-run elsewhere (--out) to compare before replacing
-the committed file; tests/test_feedback.py re-applies the rule of the file's format.
+seeds on friction x1.0), on the gains of session 40: the gated angle at K = 0.03. On the gains
+of session 52, with the tests' floors x0.7 and x1.3 in place of the tuning's, this rule picked
+the gated angle at K = 0.02, which rule V did not adopt: the run passed on friction x0.7 (73
+of 80 unused states against 9) but lost its backward push envelope (2.5 N s from the Table 3
+state against 30) and in-family transitions; on the tuning's floors it picks what
+docs/JOURNAL.md "Session 52" records. tests/test_feedback.py re-applies the rule of the
+committed file's format.
 
     python3 scripts/feedback_choice.py [--push-s 0.2] [--workers 2]
-                                       [--out cpg/feedback_gains.json]     (about 25 minutes)
+                                       [--out out/feedback_choice/feedback_gains.json]
 """
 from __future__ import annotations
 
@@ -70,13 +78,17 @@ CANDIDATES = {
 # of its synchronous presets; its and the Matsuoka network's rows are as before.
 PRESETS = {"ml": ("walk", "run", "jump", "hop"), "hopf": ("walk", "run"), "matsuoka": ("walk",)}
 SCORED = ("walk", "run")
-# Tuning-condition CPG states (envs.search.controller_tuning), never a test's: the envelopes
-# are scored over CHOICE_SEEDS (one seed, 1000, chose the committed gains first; a re-run on
-# later controller gains tied two Morris-Lecar candidates there, so the score sums four), the
-# admissibility asks ADMIT_SEEDS on each floor of ADMIT_FRICTIONS (the tests' kinds of floor).
+# Tuning-condition CPG states and floors (envs.search.controller_tuning), never a test's: the
+# envelopes are scored over CHOICE_SEEDS (one seed, 1000, chose the committed gains first; a
+# re-run on later controller gains tied two Morris-Lecar candidates there, so the score sums
+# four), the admissibility asks ADMIT_SEEDS on each floor of ADMIT_FRICTIONS (the controller
+# tuning's floors, slippery and grippy, beside x1.0).
 CHOICE_SEEDS = (1000, 1001, 1002, 1003)
 ADMIT_SEEDS = tuple(range(1000, 1020))
-ADMIT_FRICTIONS = (1.0, 0.7, 1.3)
+ADMIT_FRICTIONS = (1.0, 0.6, 0.8, 1.25, 1.6)
+NOISE_SD = 2.0  # passes: b - c <= NOISE_SD sqrt(b + c)
+NEW_LOSSES_MAX = 1  # falls and renamed rhythms: b - c <= NEW_LOSSES_MAX
+DEFAULT_OUT = Path(__file__).resolve().parents[1] / "out" / "feedback_choice" / "feedback_gains.json"
 CHOICE_PUSH_AFTER_S = 5.5
 
 
@@ -105,28 +117,31 @@ def evaluate(job):
             "score": min(env["forward"]) + min(env["backward"])}
 
 
-def no_worse(cand: list[bool], base: list[bool]) -> bool:
+def no_worse(cand: list[bool], base: list[bool], most: float | None = None) -> bool:
     """Paired outcomes (True: good) from the same states: the candidate loses b pairs and gains
-    c; no worse when b - c <= 2 sqrt(b + c), two standard deviations of a paired count."""
+    c; no worse when b - c <= NOISE_SD sqrt(b + c) (two standard deviations of a paired count),
+    or b - c <= ``most`` when given."""
     b = sum(x < y for x, y in zip(cand, base))
     c = sum(x > y for x, y in zip(cand, base))
-    return b - c <= 2.0 * (b + c) ** 0.5
+    return b - c <= (NOISE_SD * (b + c) ** 0.5 if most is None else most)
 
 
 def costs(rows, open_rows) -> list[str]:
     """What a candidate's rollouts cost against open loop's, per preset and floor (empty: the
-    candidate is admissible): passes, falls, the CPG's name, each by no_worse."""
+    candidate is admissible): passes within the noise, falls and the CPG's name within
+    NEW_LOSSES_MAX (:func:`no_worse`)."""
     ref = {(r["preset"], r["cpg_seed"], r["friction"]): r for r in open_rows}
     out = []
     for p, fr in dict.fromkeys((r["preset"], r["friction"]) for r in rows):
         pairs = [(r, ref[(p, r["cpg_seed"], fr)]) for r in rows
                  if r["preset"] == p and r["friction"] == fr]
-        for what, good in (("passes", lambda r, o: r["criteria_passed"]),
-                           ("standing", lambda r, o: not r["fell"]),
-                           ("CPG names", lambda r, o: r["cpg_gait"] == o["cpg_gait"])):
+        for what, good, most in (("passes", lambda r, o: r["criteria_passed"], None),
+                                 ("standing", lambda r, o: not r["fell"], NEW_LOSSES_MAX),
+                                 ("CPG names", lambda r, o: r["cpg_gait"] == o["cpg_gait"],
+                                  NEW_LOSSES_MAX)):
             cand = [good(r, o) for r, o in pairs]
             base = [good(o, o) for r, o in pairs]
-            if not no_worse(cand, base):
+            if not no_worse(cand, base, most):
                 out.append(f"{p} x{fr:g} {what} {sum(cand)}/{len(pairs)} "
                            f"(open loop {sum(base)})")
     return out
@@ -137,8 +152,10 @@ def main(argv=None) -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "cpg"
-                                         / "feedback_gains.json"))
+    ap.add_argument("--out", default=str(DEFAULT_OUT),
+                    help="where to write the choice (default out/feedback_choice/"
+                         "feedback_gains.json; cpg/feedback_gains.json is replaced by hand, "
+                         "after an adoption rule)")
     ap.add_argument("--push-s", type=float, default=PUSH_S,
                     help="how long each push's force is held, s (default 0.2, as SCONE's "
                          "perturbed-gait tutorial and `cpgbiped robustness`; 0.004: one "
@@ -162,6 +179,9 @@ def main(argv=None) -> int:
                          f"CPG seeds {', '.join(map(str, CHOICE_SEEDS))}, pushes in the stride "
                          f"after {CHOICE_PUSH_AFTER_S} s, each held {a.push_s:g} s (tuning "
                          f"conditions)",
+           "rule": {"admit_seeds": list(ADMIT_SEEDS), "admit_frictions": list(ADMIT_FRICTIONS),
+                    "choice_seeds": list(CHOICE_SEEDS), "scored": list(SCORED),
+                    "noise_sd": NOISE_SD, "new_losses_max": NEW_LOSSES_MAX},
            "networks": {}, "candidates": rows}
     for kind in CANDIDATES:
         by = {}
@@ -188,6 +208,7 @@ def main(argv=None) -> int:
                                  "open_loop_score_ns": open_loop["score_ns"]}
         print(f"-> {kind}: {best['form']} K = {best['gain']:g} (score {best['score_ns']:g} N s; "
               f"open loop {open_loop['score_ns']:g} N s)")
+    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps(out, indent=1) + "\n")
     print(f"wrote {a.out} in {time.time() - t0:.0f} s")
     return 0

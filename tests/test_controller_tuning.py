@@ -1147,27 +1147,32 @@ def test_tune_only_help_names_every_gain_searched_only_when_named():
 
 def test_feedback_choice_admits_a_candidate_by_paired_counts_on_each_floor():
     """scripts/feedback_choice.py (since session 52): a candidate is admissible when, per
-    preset and floor, it loses no more than 2 sqrt(b + c) net pairs against open loop's
-    rollouts from the same states (b lost, c gained), in passes, in standing and in the CPG's
-    name. Counted by hand: losing 4 of 20 passes with none gained is 4 <= 2 sqrt(4) = 4,
-    admissible; losing 5 is 5 > 2 sqrt(5) = 4.47, not; losing 16 on one floor (the gated angle
-    at K = 0.03 on friction x0.7, the run) is not, whatever the other floors do; 6 lost and
-    6 gained is 0 net, admissible."""
+    preset and floor, against open loop's rollouts from the same states (b pairs lost, c
+    gained), it loses no more than 2 sqrt(b + c) net in passing the criteria, and no more than
+    one net in standing and in the CPG's name. Counted by hand: losing 4 of 20 passes with none
+    gained is 4 <= 2 sqrt(4) = 4, admissible; losing 5 is 5 > 2 sqrt(5) = 4.47, not; 6 lost
+    and 6 gained is 0 net, admissible; 16 lost on one floor (the gated angle at K = 0.03 on a
+    slippery floor, the run) is not, though the other floor costs nothing; one new fall is
+    admitted, two are not, though two lost passes are within the noise."""
     fc = _script("feedback_choice")
     assert fc.no_worse([False] * 4 + [True] * 16, [True] * 20)
     assert not fc.no_worse([False] * 5 + [True] * 15, [True] * 20)
     assert fc.no_worse([False] * 6 + [True] * 14, [True] * 6 + [False] * 6 + [True] * 8)
+    assert fc.no_worse([False] + [True] * 19, [True] * 20, most=1)
+    assert not fc.no_worse([False] * 2 + [True] * 18, [True] * 20, most=1)
 
     def row(seed, friction, passed, fell=False, gait="run", gain=0.03):
         return {"preset": "run", "cpg_seed": seed, "friction": friction, "gain": gain,
-                "criteria_passed": passed, "fell": fell, "cpg_gait": gait}
+                "criteria_passed": passed and not fell, "fell": fell, "cpg_gait": gait}
 
-    open_rows = [row(s, f, True, gain=0.0) for f in (1.0, 0.7) for s in range(20)]
+    open_rows = [row(s, f, True, gain=0.0) for f in (1.0, 0.6) for s in range(20)]
     good = [row(s, 1.0, True) for s in range(20)]
-    slippery = [row(s, 0.7, s >= 16) for s in range(20)]  # 16 passes lost on x0.7
-    assert fc.costs(good + [row(s, 0.7, True) for s in range(20)], open_rows) == []
-    assert fc.costs(good + slippery, open_rows) == ["run x0.7 passes 4/20 (open loop 20)"]
-    renamed = [row(s, 0.7, True, gait="none" if s < 5 else "run") for s in range(20)]
-    assert fc.costs(good + renamed, open_rows) == ["run x0.7 CPG names 15/20 (open loop 20)"]
-    fallen = [row(s, 0.7, True, fell=s < 5) for s in range(20)]
-    assert fc.costs(good + fallen, open_rows) == ["run x0.7 standing 15/20 (open loop 20)"]
+    assert fc.costs(good + [row(s, 0.6, True) for s in range(20)], open_rows) == []
+    slippery = [row(s, 0.6, s >= 16) for s in range(20)]  # 16 passes lost on x0.6
+    assert fc.costs(good + slippery, open_rows) == ["run x0.6 passes 4/20 (open loop 20)"]
+    renamed = [row(s, 0.6, True, gait="none" if s < 2 else "run") for s in range(20)]
+    assert fc.costs(good + renamed, open_rows) == ["run x0.6 CPG names 18/20 (open loop 20)"]
+    one_fall = [row(s, 0.6, True, fell=s < 1) for s in range(20)]
+    assert fc.costs(good + one_fall, open_rows) == []
+    two_falls = [row(s, 0.6, True, fell=s < 2) for s in range(20)]
+    assert fc.costs(good + two_falls, open_rows) == ["run x0.6 standing 18/20 (open loop 20)"]

@@ -74,9 +74,10 @@ def test_the_readme_layout_names_every_module():
 def test_numba_caches_live_in_a_directory_named_by_the_sources(tmp_path):
     """numba keys a cached kernel on its own file only, so a kernel inlining another module's
     function ran that function's old code after it changed (session 52). cpgbiped names the
-    cache directory by a hash of every source file: an edit anywhere (not a __pycache__ file)
-    moves it, and a process that imports the package compiles into it unless the user set
-    NUMBA_CACHE_DIR."""
+    cache directory by a hash of every source file of the folders that hold kernels: an edit
+    anywhere there (not a __pycache__ file) moves it; a process that imports the package
+    compiles into it (whether numba was imported first or after); a NUMBA_CACHE_DIR the user
+    set is kept, and one this package set in a parent process is recomputed."""
     import os
 
     import cpgbiped
@@ -86,21 +87,45 @@ def test_numba_caches_live_in_a_directory_named_by_the_sources(tmp_path):
     (tree / "a.py").write_text("x = 1\n")
     (tree / "b.py").write_text("y = 2\n")
     before = cpgbiped._source_hash([tree])
-    (tree / "__pycache__" / "a.cpython-311.pyc").write_bytes(b"\0")
-    assert cpgbiped._source_hash([tree]) == before  # compiled files do not count
+    (tree / "__pycache__" / "a.py").write_text("stale copy\n")
+    assert cpgbiped._source_hash([tree]) == before  # compiled folders do not count
     (tree / "b.py").write_text("y = 3\n")
     assert cpgbiped._source_hash([tree]) != before
     (tree / "b.py").write_text("y = 2\n")
     assert cpgbiped._source_hash([tree]) == before
 
-    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    check = "print(numba.config.CACHE_DIR == cpgbiped._numba_cache_dir())"
+    import re
+
+    decorator = re.compile(r"^@njit\(.*cache=True", re.M)
+    kernels = [p for p in ROOT.glob("**/*.py") if decorator.search(p.read_text())
+               and not {"tests", "out", "build"} & set(p.relative_to(ROOT).parts)]
+    assert kernels  # every cached kernel's module lies under a hashed folder
+    assert all(any(str(p).startswith(d + os.sep) for d in cpgbiped._kernel_dirs())
+               for p in kernels)
+
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "CPGBIPED_NUMBA_CACHE_DIR")}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), str(tmp_path)])  # this tree's package
+    (tmp_path / "tiny.py").write_text("from numba import njit\n\n@njit(cache=True)\n"
+                                      "def plus_one(x):\n    return x + 1\n")
+    check = ("import numba, cpgbiped, glob, os; import tiny; tiny.plus_one(1); "
+             "d = cpgbiped._numba_cache_dir(); print(numba.config.CACHE_DIR == d, "
+             "d.startswith(os.environ['XDG_CACHE_HOME']), "
+             "bool(glob.glob(os.path.join(d, '**', 'tiny.plus_one*.nbi'), recursive=True)))")
     for imports in ("import numba, cpgbiped", "import cpgbiped, numba"):  # numba first, or after
         out = subprocess.run([sys.executable, "-c", f"{imports}; {check}"], capture_output=True,
                              text=True, env=env, cwd=tmp_path, check=True)
-        assert out.stdout.strip() == "True", out.stderr
-    env["NUMBA_CACHE_DIR"] = str(tmp_path / "mine")
-    out = subprocess.run([sys.executable, "-c", "import cpgbiped, numba; "
-                          "print(numba.config.CACHE_DIR)"], capture_output=True, text=True,
-                         env=env, cwd=tmp_path, check=True)
+        assert out.stdout.split() == ["True", "True", "True"], out.stderr
+    code = "import cpgbiped, numba; print(numba.config.CACHE_DIR)"
+    mine = dict(env, NUMBA_CACHE_DIR=str(tmp_path / "mine"))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=mine,
+                         cwd=tmp_path, check=True)
     assert out.stdout.strip() == str(tmp_path / "mine")
+    inherited = dict(env, NUMBA_CACHE_DIR=str(tmp_path / "old"),
+                     CPGBIPED_NUMBA_CACHE_DIR=str(tmp_path / "old"))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=inherited, cwd=tmp_path, check=True)
+    assert out.stdout.strip() == cpgbiped._numba_cache_dir().replace(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
+        str(tmp_path / "cache"))
