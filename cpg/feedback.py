@@ -49,9 +49,13 @@ between them):
     gated, 19 of 20 pass every hop criterion.
   scripts/feedback_choice.py scores every form at K = 0.01-0.1 (the pulse 0.05-0.2) by the
   push envelope of the walk and the run on tuning conditions (CPG seeds 1000-1003, pushes
-  after 5.5 s, each held 0.2 s as SCONE's tutorial holds them), keeping only gains at which
-  no rollout of any of the four presets falls, the CPG classifier still names the gait, and
-  each preset passes its gait's criteria in as many seeds as open loop. On the gains of
+  after 5.5 s, each held 0.2 s as SCONE's tutorial holds them); since session 52 it admits a
+  gain when, over twenty tuning states on friction x1.0, x0.6, x0.8, x1.25 and x1.6, paired
+  with open loop, no preset loses more passes than the noise allows nor more than one net
+  fall or renamed rhythm per floor (its docstring). The committed choice was made by the rule
+  before it, which kept only gains at which no rollout of any of the four presets falls (four
+  seeds, friction x1.0), the CPG classifier still names the gait, and each preset passes its
+  gait's criteria in as many seeds as open loop. On the gains of
   2026-12-06 "angle_alternating" at K = 0.03 scores 285 N s (open loop 182.5; "angle" at
   K = 0.01 192.5 and at 0.03 252.5, both inadmissible: the hop falls in a seed and passes in
   2 of 4, open loop 3); checked on unused states before adoption (docs/JOURNAL.md, session
