@@ -46,12 +46,14 @@ seeds on friction x1.0), on the gains of session 40: the gated angle at K = 0.03
 of session 52, with the tests' floors x0.7 and x1.3 in place of the tuning's, this rule picked
 the gated angle at K = 0.02, which rule V did not adopt: the run passed on friction x0.7 (73
 of 80 unused states against 9) but lost its backward push envelope (2.5 N s from the Table 3
-state against 30) and in-family transitions; on the tuning's floors it picks what
-docs/JOURNAL.md "Session 52" records. tests/test_feedback.py re-applies the rule of the
-committed file's format.
+state against 30) and in-family transitions; on the tuning's floors it picks the gated angle
+at K = 0.01 (175 N s, below open loop's 180; not put to a rule), Hopf Tegotae K = 1 and
+Matsuoka Taga K = 0.1 (docs/JOURNAL.md, "Session 52"). tests/test_feedback.py re-applies the
+rule of the committed file's format.
 
     python3 scripts/feedback_choice.py [--push-s 0.2] [--workers 2]
                                        [--out out/feedback_choice/feedback_gains.json]
+                                       (about 17 minutes on 2 cores)
 """
 from __future__ import annotations
 
