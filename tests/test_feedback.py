@@ -2,7 +2,6 @@
 phase response (issue 21)."""
 from __future__ import annotations
 
-import functools
 import json
 import os
 import subprocess
@@ -16,6 +15,8 @@ from cpgbiped.cpg.errors import InputError
 from cpgbiped.cpg.feedback import CHOICE, LOAD_CONTACT, RECOMMENDED, check_gain, loop_network, run_open
 from cpgbiped.cpg.network import build
 from cpgbiped.envs.simulation.rollout import rollout
+from tests.test_physics import CONDITION_IDS, CONDITIONS, others_for, summary
+from tests.test_physics import _cases as physics_cases
 
 # The rollouts recorded before the closed loop existed (commit 7c11c25): network, preset, CPG
 # seed, push (time s, impulse N s); 2.5 s each, stop_on_fall=False; every 5th row of their 45
@@ -384,47 +385,20 @@ def test_the_envelope_takes_the_gains_it_is_given(monkeypatch):
 
 
 # -- what issue 21 asks and the closed loop does not reach (measured, README "Feedback") ----
-@functools.cache
-def _closed_loop_summary(gait, cond_items):
-    """The Morris-Lecar preset of ``gait`` with the recommended feedback, the 20 s after
-    settling (criteria.WINDOW_S), as ``validate --feedback`` measures it, under a test
-    condition given as sorted (key, value) pairs (cached per process)."""
-    from cpgbiped.envs.gaits.criteria import WINDOW_S
-    from cpgbiped.envs.gaits.validate import validate
-
-    cond = dict(cond_items)
-    return validate(build("ml", gait, seed=cond.pop("seed", None)), gait, WINDOW_S,
-                    feedback=RECOMMENDED["ml"], **cond).summary()
-
-
-def _closed_loop(gait, cond):
-    return _closed_loop_summary(gait, tuple(sorted(cond.items())))
-
-
 # Issue 21's first clause, measured with the recommended feedback (README "Status", issue 21's
-# row; scripts/report_feedback.py): case -> what was measured. Every miss sits at a criterion's
-# edge or is a single fall or a late regular start of a chaotic body, which a change far away
-# moves (non-strict, as tests/test_physics.py's).
+# row; scripts/report_feedback.py): case -> (what was measured, strict). Every miss sits at a
+# criterion's edge or is a single fall or a late regular start of a chaotic body, which a
+# change far away moves (non-strict, as tests/test_physics.py's).
 CLOSED_LOOP_SHORTFALLS = {
-    "walk-friction1.3": "Froude number 0.0799 against 0.08 (since session 50)",
-    "run-friction0.7": "the left leg's duty 0.299 against 0.30",
-    "hop-seed18": "stride CV 0.13: its strides regular only from 5.5 s",
-    "hop-friction1.3": "falls at 9.9 s (since session 50)",
+    "walk-friction1.3": ("Froude number 0.0799 against 0.08 (since session 50)", False),
+    "run-friction0.7": ("the left leg's duty 0.299 against 0.30", False),
+    "hop-seed18": ("stride CV 0.13: its strides regular only from 5.5 s", False),
+    "hop-friction1.3": ("falls at 9.9 s (since session 50)", False),
 }
 
 
-def _closed_loop_cases():
-    from tests.test_physics import CONDITION_IDS, CONDITIONS, GAITS
-
-    for gait in GAITS:
-        for cond, cid in zip(CONDITIONS, CONDITION_IDS):
-            why = CLOSED_LOOP_SHORTFALLS.get(f"{gait}-{cid}")
-            marks = [pytest.mark.xfail(strict=False, raises=AssertionError, reason=why)
-                     ] if why else []
-            yield pytest.param(gait, cond, marks=marks, id=f"{gait}-{cid}")
-
-
-@pytest.mark.parametrize("gait,cond", list(_closed_loop_cases()))
+@pytest.mark.parametrize("gait,cond", list(physics_cases(CONDITIONS, CONDITION_IDS,
+                                                         CLOSED_LOOP_SHORTFALLS)))
 def test_every_preset_meets_its_criteria_with_feedback(gait, cond):
     """Issue 21: with feedback at the recommended gain every Morris-Lecar preset still passes
     every criterion of its gait in each of the 13 test conditions (as
@@ -434,9 +408,8 @@ def test_every_preset_meets_its_criteria_with_feedback(gait, cond):
     fails every criterion)."""
     from cpgbiped.envs.gaits.criteria import CRITERIA
 
-    s = _closed_loop(gait, cond)
-    ref = CRITERIA[gait].cadence_above
-    failures = CRITERIA[gait].failures(s, {ref: _closed_loop(ref, cond)} if ref else {})
+    cond = dict(cond, feedback=RECOMMENDED["ml"])
+    failures = CRITERIA[gait].failures(summary(gait, **cond), others_for(gait, cond))
     assert not failures, failures  # the criteria include the CPG classifier's name
 
 

@@ -34,17 +34,20 @@ PERTURBATION_IDS = ["friction0.5", "friction2.0", "push+5", "push-5", "blow+5", 
 
 
 @functools.cache
-def _summary(gait, seed, friction_scale, ankle_drive, push):
+def _summary(gait, seed, friction_scale, ankle_drive, push, feedback):
     v = validate(build("ml", gait, seed=seed), gait, WINDOW_S, friction_scale=friction_scale,
-                 ankle_drive=ankle_drive, push=push)
+                 ankle_drive=ankle_drive, push=push, feedback=feedback)
     s = v.summary()
     s["touchdowns"] = v.metrics.touchdowns
     return s
 
 
-def summary(gait: str, seed=None, friction_scale=1.0, ankle_drive=True, push=None) -> dict:
-    """The Morris-Lecar preset of ``gait`` through the one controller (cached per process)."""
-    return _summary(gait, seed, friction_scale, ankle_drive, None if push is None else tuple(push))
+def summary(gait: str, seed=None, friction_scale=1.0, ankle_drive=True, push=None,
+            feedback=0.0) -> dict:
+    """The Morris-Lecar preset of ``gait`` through the one controller, open loop or with the
+    feedback gain ``feedback`` (cached per process)."""
+    return _summary(gait, seed, friction_scale, ankle_drive, None if push is None else tuple(push),
+                    feedback)
 
 
 def others_for(gait: str, cond: dict) -> dict:
@@ -94,10 +97,10 @@ KNOWN_SHORTFALLS: dict[str, tuple[str, bool]] = {
 }
 
 
-def _cases(conditions, ids):
+def _cases(conditions, ids, shortfalls=KNOWN_SHORTFALLS):
     for gait in GAITS:
         for cond, cid in zip(conditions, ids):
-            known = KNOWN_SHORTFALLS.get(f"{gait}-{cid}")
+            known = shortfalls.get(f"{gait}-{cid}")
             marks = [pytest.mark.xfail(strict=known[1], reason=known[0],
                                        raises=AssertionError)] if known else []
             yield pytest.param(gait, cond, id=f"{gait}-{cid}", marks=marks)
