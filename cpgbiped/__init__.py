@@ -59,10 +59,41 @@ def _numba_cache_dir() -> str:
         try:
             _os.makedirs(path, exist_ok=True)
             if _os.access(path, _os.W_OK):
+                _prune_stale(path)
                 return path
         except OSError:
             pass
     return _os.path.join(tempfile.gettempdir(), name)
+
+
+STALE_CACHE_DAYS = 30  # a hash directory no import has used for this long is removed
+
+
+def _prune_stale(path: str, days: float = STALE_CACHE_DAYS) -> None:
+    """Mark ``path`` (a hash directory of :func:`_numba_cache_dir`) as used now, and remove its
+    siblings that no import has marked for ``days``: each source edit leaves the old kernels
+    behind (a few MB), and another checkout's directory stays as long as it is in use. Only
+    names of 16 hex digits (this package's) are touched; errors are ignored."""
+    import shutil
+    import string
+    import time
+
+    _os.utime(path)
+    parent = _os.path.dirname(path)
+    too_old = time.time() - days * 86400.0
+    try:
+        names = _os.listdir(parent)
+    except OSError:
+        return
+    for name in names:
+        other = _os.path.join(parent, name)
+        if (len(name) == 16 and set(name) <= set(string.hexdigits.lower()) and other != path
+                and _os.path.isdir(other) and not _os.path.islink(other)):
+            try:
+                if _os.stat(other).st_mtime < too_old:
+                    shutil.rmtree(other, ignore_errors=True)
+            except OSError:
+                pass
 
 
 def _use_numba_cache_dir() -> None:

@@ -77,8 +77,10 @@ def test_numba_caches_live_in_a_directory_named_by_the_sources(tmp_path):
     cache directory by a hash of every source file of the folders that hold kernels: an edit
     anywhere there (not a __pycache__ file) moves it; a process that imports the package
     compiles into it (whether numba was imported first or after); a NUMBA_CACHE_DIR the user
-    set is kept, and one this package set in a parent process is recomputed."""
+    set is kept, and one this package set in a parent process is recomputed. Hash directories
+    that no import has used for STALE_CACHE_DAYS are removed; the one in use never is."""
     import os
+    import time
 
     import cpgbiped
 
@@ -113,10 +115,26 @@ def test_numba_caches_live_in_a_directory_named_by_the_sources(tmp_path):
              "d = cpgbiped._numba_cache_dir(); print(numba.config.CACHE_DIR == d, "
              "d.startswith(os.environ['XDG_CACHE_HOME']), "
              "bool(glob.glob(os.path.join(d, '**', 'tiny.plus_one*.nbi'), recursive=True)))")
+    # hash directories left by earlier sources: one unused for longer than STALE_CACHE_DAYS
+    # (removed by the next import), one used lately and a folder that is not ours (kept)
+    hashes = tmp_path / "cache" / "cpgbiped" / "numba"
+    stale, recent, other = hashes / "0123456789abcdef", hashes / "fedcba9876543210", hashes / "x"
+    for d, days in ((stale, cpgbiped.STALE_CACHE_DAYS + 1), (recent, 1),
+                    (other, cpgbiped.STALE_CACHE_DAYS + 1)):
+        (d / "k").mkdir(parents=True)
+        (d / "k" / "kernel.nbi").write_text("")
+        old = time.time() - days * 86400
+        os.utime(d, (old, old))
     for imports in ("import numba, cpgbiped", "import cpgbiped, numba"):  # numba first, or after
         out = subprocess.run([sys.executable, "-c", f"{imports}; {check}"], capture_output=True,
                              text=True, env=env, cwd=tmp_path, check=True)
         assert out.stdout.split() == ["True", "True", "True"], out.stderr
+    assert not stale.exists() and recent.is_dir() and other.is_dir()
+    # the directory in use is marked at each import, so an old one in use is never removed
+    ours = next(d for d in hashes.iterdir() if d not in (recent, other))
+    os.utime(ours, (time.time() - 90 * 86400,) * 2)
+    subprocess.run([sys.executable, "-c", "import cpgbiped"], env=env, cwd=tmp_path, check=True)
+    assert ours.is_dir() and time.time() - ours.stat().st_mtime < 3600
     code = "import cpgbiped, numba; print(numba.config.CACHE_DIR)"
     mine = dict(env, NUMBA_CACHE_DIR=str(tmp_path / "mine"))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=mine,
