@@ -1,7 +1,7 @@
 """Calibrate the Hopf presets' activation centres (cpg/hopf_activation.json).
 
 Rule (a computation on the networks alone; no rollout of the body enters it; chosen after a
-hand sweep of c on the Hopf walk's matrix row, README "Matrices"): each Hopf preset's cells
+hand sweep of c on the Hopf walk's matrix row, docs/RESULTS.md "Matrices"): each Hopf preset's cells
 burst (activation 1 / (1 + exp(-(y - c) / 0.1)) above one half, i.e. y > c) for the same
 mean fraction of the cycle as the Morris-Lecar preset of the same gait from its Table 3 state
 (cpg.network.burst_fraction, 20 cycles after the settling time); the Hopf preset runs from

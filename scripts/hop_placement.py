@@ -3,13 +3,13 @@
 
     python scripts/hop_placement.py START.json OUT
 
-Used by scripts/tune_gains.sh after the walk's stance knee (README, "Transitions"). The hop
+Used by scripts/tune_gains.sh after the walk's stance knee (docs/JOURNAL.md, "The hop corner's foot placement"). The hop
 corner (synchronous, co-activated) placed the feet with c_v = 0.054 rad per m/s of forward
 speed, the value a search for a hop in place left it at: a body that arrives at a walk's or a
 run's speed when the network's bursts go in phase (a change from walk or run to jump or hop)
-has nothing that brakes it, and pronks forwards until it falls (README, "Transitions"). A run
+has nothing that brakes it, and pronks forwards until it falls (docs/JOURNAL.md, "The hop corner's foot placement"). A run
 -> walk change, whose network also bursts both legs together for cycles, was expected to gain
-too and was measured to lose: as a ramp with feedback it reaches the walk later (README). 0.3 rad per m/s is a
+too and was measured to lose: as a ramp with feedback it reaches the walk later (docs/JOURNAL.md). 0.3 rad per m/s is a
 Raibert hopper's sign and about twice the neutral point of a 0.2 s stance (v T_st / 2 over a
 0.8 m leg: 0.13 rad per m/s); at the hop's own drift (-0.07 m/s) it moves the feet by 0.02 rad.
 Measured before the rule on tuning CPG seeds only (1000-1031): the switches of walk -> jump,

@@ -8,7 +8,7 @@ Used by scripts/tune_gains.sh after the hop corner's foot placement. The ankle's
 centres, 5 cm ahead of the ankles; its take-off, whose extensor burst moves the centre of
 pressure to the forefoot, then pushed the body backwards (the committed jump drifted at -0.045
 m/s against the -0.05 allowed), and on floors of friction x0.5 and x2.0 the reflex's saturated
-flexor lifted the toes in the silence and the body tipped back over its heels (README,
+flexor lifted the toes in the silence and the body tipped back over its heels (docs/RESULTS.md,
 "Perturbations"). x_bal = 0.05 m puts the reference over the ball of the foot (about 70% of the
 24 cm foot from the heel, 10 cm ahead of the ankle), where a standing jumper puts the centre of
 mass before a vertical jump. Measured on tuning CPG seeds 1000-1019 only (jump falls of 20:

@@ -3,7 +3,7 @@
 
     python scripts/jump_speed.py START.json OUT
 
-Used by scripts/tune_gains.sh after stage jx3 (README, "Jump"). The speed
+Used by scripts/tune_gains.sh after stage jx3 (docs/JOURNAL.md, "Jump"). The speed
 term c_v of the thigh target theta = theta0 + c_v v_com + c_d (x_com - x_sup) is searched in
 [0, 0.8] by every stage (a Raibert hopper's sign: the foot lands further ahead the faster the body
 moves). In the two-legged jump it works the other way round, measured: a smaller c_v (down to

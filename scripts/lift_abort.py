@@ -3,7 +3,7 @@ set and why), from START's gains into OUT/la.
 
     python scripts/lift_abort.py START.json OUT
 
-Used by scripts/tune_gains.sh as its last link (README, "Start-up deadlock"). A leg lifts only
+Used by scripts/tune_gains.sh as its last link (docs/RESULTS.md, "Start-up deadlock"). A leg lifts only
 while the other stands, but until now its lift lasted until its own foot had left the ground
 and landed again: when the other foot left the ground first (pushed off by its extensor burst in
 a CPG start-up transient), the lifting leg stood on the ground in its swing mode, tucking its

@@ -17,7 +17,7 @@ confirmations net of falls are more; a tie goes to fewer falls, then to A. With
 no more than F states above A's: confirmations bought with falls are refused.
 The Table 3 state is never used to choose. Prints each target's counts and
 the sums of A, B and the merge over those states (a rule about replacing a committed file is
-the caller's: README "Secondary gaits in the body"). Writes MERGED.json (format
+the caller's: docs/RESULTS.md "Secondary gaits in the body"). Writes MERGED.json (format
 "cpgbiped.secondary/1") with A's command, B's command and this one, and per target which file
 it came from and its counts ("merged_from").
 

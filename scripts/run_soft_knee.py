@@ -6,10 +6,10 @@ OUT/rk/gains.json.
     python scripts/run_soft_knee.py --free     (the run corner's gains the stages after it
                                                 search: all but HELD and the opt-in ones)
 
-Why (README, "Run"): the run bounded (duty 0.13, flight 0.74) because its stance leg launched
+Why (docs/JOURNAL.md, "Run"): the run bounded (duty 0.13, flight 0.74) because its stance leg launched
 at once: the ankle's balance reflex (k_av 1.6 activation per m/s) held both extensors saturated
 at 2 m/s, and the knee extended as a piston (kp_push 3.9, a constant push 0.47 of the gear).
-Searches from there always returned to the bound (README, "The run's duty, tried"). Here the
+Searches from there always returned to the bound (docs/JOURNAL.md, "The run's duty, tried"). Here the
 reflex is off (k_ax = k_av = 0: the CPG's own drive, at the shared gain, still reaches the
 ankles) and the knee in the burst is soft (target -0.75 rad, stiffness 0.5, push 0.25: the
 values of the hand sweep in which the duty reached 0.32-0.42 before the trunk fell), and the

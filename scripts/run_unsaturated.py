@@ -3,7 +3,7 @@
 
     python scripts/run_unsaturated.py START.json OUT.json
 
-Used by scripts/tune_run_experiment.sh (README "The run's duty, tried after the walk").
+Used by scripts/tune_run_experiment.sh (docs/JOURNAL.md, "The run's duty, tried after the walk").
 """
 import sys
 

@@ -38,7 +38,7 @@ stage w3 --gait walk --conditions 12 --gens 60 --pop 16 --sigma 0.05 --seed 24
 # ... and a finer step over all 16 conditions: after w3 the walk fell under one of the four
 # last (another walk network at friction x1.25, or the closed loop with a push).
 stage w4 --gait walk --conditions 16 --gens 30 --pop 16 --sigma 0.03 --seed 26
-# The jump (README, "Start-up gains"; stages j1 and j2 of scripts/tune_jump_experiment.sh): its
+# The jump (docs/RESULTS.md, "Start-up gains"; stages j1 and j2 of scripts/tune_jump_experiment.sh): its
 # corner set by hand to a countermovement, searched alone, then scored on the walk too.
 walk_end="$prev"
 python3 scripts/jump_countermovement.py "$prev" "$OUT"
@@ -51,21 +51,21 @@ python3 scripts/select_startup_tau.py --live "$prev" --startup-from "$walk_end" 
     --out "$OUT/startup_selection.json" --apply "$OUT/s1/gains.json" --note \
     "the jump corner of stage j2 jumps, but changed every walk's first steps (the features start at a quarter of each corner); the corners the chain had before the jump's stages (w4) start the body and hand over as exp(-t/tau_s); tau_s chosen by scripts/select_startup_tau.py on CPG seeds 2000-2099 (envs/control/startup_selection.json)"
 prev="$OUT/s1/gains.json"
-# The jump's push (README, "Jump"): the corner's burst push set lower by hand, then searched
+# The jump's push (docs/JOURNAL.md, "Jump"): the corner's burst push set lower by hand, then searched
 # scored on the walk too, the walk guarded against the gains before it.
 startup_end="$prev"
 python3 scripts/jump_push.py "$prev" "$OUT"
 prev="$OUT/p1/gains.json"
 stage jx3 --gait walk,jump --only 'synchronous.*' --guard walk --guard-gains "$startup_end" --conditions 1-8,21-24 --gens 30 --pop 16 --sigma 0.05 --seed 64
-# The jump corner's foot-placement speed term set by hand below the search box (README, "Jump"):
+# The jump corner's foot-placement speed term set by hand below the search box (docs/JOURNAL.md, "Jump"):
 # a smaller c_v slows the jump's backward drift, the opposite of a Raibert hopper's sign.
 python3 scripts/jump_speed.py "$prev" "$OUT"
 prev="$OUT/v1/gains.json"
-# The lift abort (README, "Start-up deadlock"): a rule of the controller's swing latch, switched
+# The lift abort (docs/RESULTS.md, "Start-up deadlock"): a rule of the controller's swing latch, switched
 # on by hand after a measurement on the tuning conditions.
 python3 scripts/lift_abort.py "$prev" "$OUT"
 prev="$OUT/la/gains.json"
-# tau_s re-chosen at the chain's end (README, "Start-up gains"): the links after the first choice
+# tau_s re-chosen at the chain's end (docs/RESULTS.md, "Start-up gains"): the links after the first choice
 # moved the corners it hands over to; the same rule, the same start-up corners (w4's). The
 # committed envs/control/startup_selection_end.json was made with --live envs/control/gains.json
 # (the same parameters as la's but tau_s, which every candidate replaces): its counts must match.
@@ -80,7 +80,7 @@ old = json.load(open("envs/control/startup_selection_end.json"))["candidates"]
 print("tune_gains: tau_s selection", "matches" if new == old else "DIFFERS from",
       "envs/control/startup_selection_end.json")
 PY
-# The run's stance (README, "Run"): the run corner's ankle reflex off and its stance knee a
+# The run's stance (docs/JOURNAL.md, "Run"): the run corner's ankle reflex off and its stance knee a
 # spring, set by hand, then its 19 other gains searched with those held and the criteria's
 # shortfalls weighted 12 instead of 3 (the bound cost less than a jog at the default weight):
 # over 4 conditions of 16 s, then 8 of 20 s. About 6 minutes.
@@ -89,7 +89,7 @@ prev="$OUT/rk/gains.json"
 RUN_FREE=$(python3 scripts/run_soft_knee.py --free)
 stage rs1 --gait run --only "$RUN_FREE" --conditions 4 --seconds 16 --gens 60 --pop 16 --sigma 0.15 --seed 107 --shortfall-weight 12
 stage rs2 --gait run --only "$RUN_FREE" --conditions 8 --seconds 20 --gens 60 --pop 16 --sigma 0.08 --seed 108 --shortfall-weight 12
-# The walk's pushes (README, Status, "The walk's pushes"): the walk corner over
+# The walk's pushes (docs/JOURNAL.md, "The walk's pushes"): the walk corner over
 # the first 16 conditions and four pushes of 8 N s (conditions 25-28), the walk guarded against
 # the gains before it; then the same corner scored on the walk, the run and the jump at once,
 # all three guarded against the gains before wp1 (the walk corner's gains blend into the run's
@@ -100,20 +100,20 @@ stage rs2 --gait run --only "$RUN_FREE" --conditions 8 --seconds 20 --gens 60 --
 rs2_end="$prev"
 stage wp1 --gait walk --guard walk --conditions 1-16,25-28 --seconds 20 --gens 30 --pop 16 --sigma 0.03 --seed 130
 stage wp2 --gait walk,run,jump --only 'alternating.*' --guard walk,run,jump --guard-gains "$rs2_end" --conditions 1-16,25-28 --seconds 20 --gens 20 --pop 16 --sigma 0.02 --seed 132
-# The walk's stance knee (README, "The walk's stance knee"): set by hand after a sweep and a
+# The walk's stance knee (docs/JOURNAL.md, "The walk's stance knee"): set by hand after a sweep and a
 # rule on tuning states: the walk's duty sat at the criterion's edge.
 python3 scripts/walk_crouch.py "$prev" "$OUT"
 prev="$OUT/wc/gains.json"
-# The hop corner's foot placement (README, "Transitions"): a Raibert hopper's speed term, set by
+# The hop corner's foot placement (docs/RESULTS.md, "Transitions"; docs/JOURNAL.md, "The hop corner's foot placement"): a Raibert hopper's speed term, set by
 # hand after a rule on fresh CPG states; bodies arriving at a walk's or a run's speed in the
 # hop's rhythm brake.
 python3 scripts/hop_placement.py "$prev" "$OUT"
 prev="$OUT/hp/gains.json"
-# The jump corner's balance reference (README, "Status"; journal, session 32): over the ball
+# The jump corner's balance reference (docs/RESULTS.md, "Status"; journal, session 32): over the ball
 # of the foot, set by hand after a sweep on tuning states and a rule fixed before the tests.
 python3 scripts/jump_balance_reference.py "$prev" "$OUT"
 prev="$OUT/jb/gains.json"
-# The run's swing clearance (README, "Status"; journal, session 34): the run corner's toes lifted
+# The run's swing clearance (docs/RESULTS.md, "Status"; journal, session 34): the run corner's toes lifted
 # early in the swing (toe_up: the run stubbed them and fell now and then at any time) and its
 # placement offset moved to keep the speed, set by hand; then the run corner's gains and its
 # stance knee searched over 8 conditions of 30 s, the criteria's shortfalls weighted 30 (the
@@ -121,7 +121,7 @@ prev="$OUT/jb/gains.json"
 python3 scripts/run_toe_clearance.py "$prev" "$OUT"
 prev="$OUT/tc/gains.json"
 stage rc --gait run --only "$(python3 scripts/run_toe_clearance.py --free)" --conditions 8 --seconds 30 --gens 50 --pop 16 --sigma 0.06 --seed 344 --shortfall-weight 30
-# The hop (README, "Status"; journal, sessions 33 and 35): session 33's hop corner, whose trunk
+# The hop (docs/RESULTS.md, "Status"; journal, sessions 33 and 35): session 33's hop corner, whose trunk
 # leans with the knees' flexion (lean_knee) and whose velocity reflex is held at the run's
 # start-up's, found by a census and a local search on tuning states scored with the gains of
 # that day (stage jb's, before the run's swing clearance); then the walk's start-up corner
@@ -132,7 +132,7 @@ python3 scripts/hop_squat_search.py --census-box squat_kav --census-seed 10 --ba
 prev="$OUT/hs/gains.json"
 python3 scripts/walk_startup_search.py --start "$prev" --guard falls --adopted --out "$OUT/ws"
 prev="$OUT/ws/gains.json"
-# A lone foot in a synchronous rhythm lands (README, "Status"; journal, session 38): a foot off
+# A lone foot in a synchronous rhythm lands (docs/RESULTS.md, "Status"; journal, session 38): a foot off
 # the ground while the other stands in the jump's or the hop's rhythm extends to land instead of
 # tucking by its swing drive; set by hand after a rule on rates over unused CPG states.
 python3 scripts/sync_land.py "$prev" "$OUT"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # An experiment, not the committed gains: a jump with a countermovement, searched while the
-# walk scores it (README "The jump's falls, traced and tried"). From stage w4 of
+# walk scores it (docs/JOURNAL.md "The jump's falls, traced and tried"). From stage w4 of
 # scripts/tune_gains.sh (the gains before the jump was adopted; START),
 # by hand (links of the chain with their provenance, set_by_hand): the jump's corner aims the
 # thighs straight down (theta0 0; 0.22 put every landing ahead of the centre of mass), crouches

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # An experiment, not the committed gains: the run's corner moved out of the bounding basin
-# (README "The run's duty, tried after the walk"). From the committed gains file (its start-up
+# (docs/JOURNAL.md "The run's duty, tried after the walk"). From the committed gains file (its start-up
 # gains included), the run's ankle balance reflex is unsaturated and its push softened by hand
 # (a link of the chain with its provenance, set_by_hand), the landing yield started at 0.5,
 # then CMA-ES stages of the run's corner (every gain, the yield included) over 4 and 8 tuning

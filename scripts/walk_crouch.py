@@ -3,7 +3,7 @@ what was set and why), from START's gains into OUT/wc.
 
     python scripts/walk_crouch.py START.json OUT
 
-Used by scripts/tune_gains.sh after stage wp2 (README, "The walk's stance knee"). The walk
+Used by scripts/tune_gains.sh after stage wp2 (docs/JOURNAL.md, "The walk's stance knee"). The walk
 corner's knee target in the stance crouch, knee_crouch, was -0.76 rad after wp1, wp2; its
 settled walk's duty sat at 0.56-0.57, just above the walk criterion's 0.55, so that the
 start-up's limp (the 5 CPG cycles before 8 s, where issue 22's transitions look at the walk)

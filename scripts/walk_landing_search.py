@@ -2,7 +2,7 @@
 tuning states only.
 
 The committed walk lands on its toes with the knee flexed 47 degrees, and its heel slaps down
-50 ms later at about 4 body weights (a human walk peaks at 1.1-1.3; README, "The vertical ground
+50 ms later at about 4 body weights (a human walk peaks at 1.1-1.3; docs/RESULTS.md, "The vertical ground
 forces"). A straighter landing knee alone lowers the peak but slows the walk to Fr 0.06, and a
 slower walk slaps less whatever slows it (docs/JOURNAL.md, session 36). This searches ten gains
 of the walk's corner (``corners.alternating``: the landing knee and its stiffness in the air,

@@ -474,7 +474,7 @@ def _longest_lift_on_the_only_foot(rec) -> float:
 
 
 def test_lift_abort_ends_a_lift_that_the_other_foot_leaves_alone():
-    """lift_abort (README "Start-up deadlock"): from the random CPG state of seed 7 the jump
+    """lift_abort (docs/RESULTS.md "Start-up deadlock"): from the random CPG state of seed 7 the jump
     network lifts the left leg while the right stands, then the right extensor pushes the right
     foot off before the left foot has left the ground. Without the rule the left leg stays in
     its lift mode on the ground, carrying the body, for more than 0.2 s, and the body falls in

@@ -322,7 +322,7 @@ def control_from(t_s, a, P, S, qpos, qvel, sens, xpos, ix, u):
     # the other foot is off the ground. With lift_abort, a lift whose foot has not yet left
     # the ground ends when the other foot leaves it first: the leg would otherwise lift away
     # what has become the only support (a deadlock: a swinging leg standing on the ground,
-    # found in the CPG's start-up transients, README "Start-up deadlock").
+    # found in the CPG's start-up transients, docs/RESULTS.md "Start-up deadlock").
     stance_cmd = np.empty(2, dtype=np.bool_)
     for i in range(2):
         stance_cmd[i] = e[i] >= e_on

@@ -150,7 +150,7 @@ the same features, that hand over to the corners above from the moment the body 
 While the features are still near their neutral prior (a quarter of each corner) and the
 CPG's first cycles pass other corners, the body runs on gains that a later search of one
 corner does not move: without them, a search of the jump's corner changed every walk's first
-steps (README, "Start-up gains"). They change no rhythm: which corner's gains apply is still
+steps (docs/RESULTS.md, "Start-up gains"). They change no rhythm: which corner's gains apply is still
 the CPG's features' choice. With restart_v > 0 (m/s; 0 in the committed gains) the alternating
 co-activated corner's (the run's) start-up gains also return whenever the body is slow in an
 alternating rhythm, as after a backward push, through a walk -> run change or into a run from

@@ -17,7 +17,7 @@ between upcrossings of E_ON (the controller's stance command) by the left extens
 activation, read from the CPG's signals, never from the body: with T_cpg that median,
 T_cpg = median(diff(t_k)), t_k the times at which a_LE(t) rises through E_ON. Speed = stride
 length / stride period, so the picture's middle panel says which of the two a change of speed
-came from, and whether the body's strides keep the network's cycle (README, "Why the walk slows
+came from, and whether the body's strides keep the network's cycle (docs/RESULTS.md, "Why the walk slows
 as the drive rises").
 """
 from __future__ import annotations

@@ -36,7 +36,7 @@ loop without a body, named by the CPG classifier over windows of NETWORK_WINDOW_
 cycles of B that start 0, 1, ... cycles after the change (``cpg.gaits.named_windows``);
 ``cycles_to_switch`` there is the first window from which every later one names B (None: not
 within NETWORK_WINDOWS). When it is above 4, no body driven open loop can pass issue 22's test
-(README, "What the network alone allows"); with feedback it is the reference the coupled
+(docs/RESULTS.md, "What the network alone allows"); with feedback it is the reference the coupled
 system is compared with.
 """
 from __future__ import annotations

@@ -113,7 +113,7 @@ def score(rows: list[dict], objectives) -> tuple:
     falls from in 4 is worth 8, one confirmed in 9 without a fall 9; a state without a rhythm,
     ``fell`` None, is no fall), then the fewest falls, then the smallest sum of the network
     objectives. Until session 40 the confirmations alone came first, and the body chose sets
-    that fall often (README, "Secondary gaits in the body")."""
+    that fall often (docs/RESULTS.md, "Secondary gaits in the body")."""
     confirmed = sum(r["confirmed"] for r in rows)
     falls = sum(r["fell"] is True for r in rows)
     return net_rank(confirmed, falls) + (float(np.sum(objectives)),)
