@@ -187,6 +187,34 @@ def test_spread_and_choice():
     pts = [{"objectives": {"failed_fraction": f, "froude_error": e, "cost": c}}
            for f, e, c in ((0.5, 0.0, 0.1), (0.0, 0.2, 3.0), (0.0, 0.1, 5.0))]
     assert choose(pts) == 2
+    # A point whose rollout fails one of its gait's criteria (say, the hop's stride CV) is not
+    # chosen while another passes them all, however robust it is; with none passing, as above.
+    for p, passes in zip(pts, (True, False, False)):
+        p["metrics"] = {"passes_criteria": passes}
+    assert choose(pts) == 0
+    for p in pts:
+        p["metrics"]["passes_criteria"] = False
+    assert choose(pts) == 2
+
+
+def test_a_trial_says_whether_it_passes_its_gaits_criteria_as_validate_does():
+    """run_trial's passes_criteria is validate's verdict on the same rollout. The paper's run
+    measured over 20 s passes; over its first 4 s after settling the body is still speeding up
+    (a run named a run, but at Fr about 0.23, under the 0.25 a jog needs, README "Status") and
+    fails."""
+    from cpgbiped.cpg.network import build
+    from cpgbiped.envs.gaits.validate import validate
+
+    x = paper_point("run")
+    verdicts = []
+    for seconds in (20.0, 4.0):
+        r = run_trial(Trial("run", tuple(x[:3]), x[3], x[4]), seconds)
+        v = validate(build("ml", "run", weights=list(x[:3]), i_app=x[3], phi=x[4]), "run",
+                     seconds).summary()
+        assert r.physical_gait == v["physical_gait"] == "run" and not r.fell
+        assert r.passes_criteria == v["passed"]
+        verdicts.append(r.passes_criteria)
+    assert verdicts == [True, False]
 
 
 @pytest.mark.parametrize("args, message", [

@@ -429,8 +429,11 @@ def cmd_optimize_physics(a) -> int:
         f"  {name:7s} w = ({', '.join(f'{w:+.3f}' for w in q['weights'])}), I_app {q['i_app']:.3f}, "
         f"phi {q['phi']:.3f}: Fr {q['metrics']['froude']:.4f}, cost {q['objectives']['cost']:.3f}, "
         f"failed {q['objectives']['failed_fraction']:.2f}, {q['metrics']['physical_gait']}"
-        f"{', fell' if q['metrics']['fell'] else ''}")
-    print(f"{gait} in physics (Froude target {settings.froude:g}): {f['n_points']} Pareto points, "
+        f"{', fell' if q['metrics']['fell'] else ''}"
+        f"{'' if q['metrics'].get('passes_criteria') else ', misses a criterion'}")
+    n_pass = sum(bool(q["metrics"].get("passes_criteria")) for q in r["pareto"])
+    print(f"{gait} in physics (Froude target {settings.froude:g}): {f['n_points']} Pareto points "
+          f"({n_pass} passing every criterion of the {gait}), "
           f"Froude {f['froude_range'][0]:.4f}-{f['froude_range'][1]:.4f}, cost "
           f"{f['cost_range'][0]:.3f}-{f['cost_range'][1]:.3f}")
     print(line("chosen", c))

@@ -10,8 +10,10 @@ Files in the output folder (all replaced at once when the run succeeds):
 - ``<gait>_physics_pareto.png``: the three 2-D projections of the objectives.
 
 The Pareto set is taken over every point evaluated during the search (the final population
-alone crowds into one region). The chosen point is the most robust feasible Pareto point (fewest failed perturbation trials),
-then the one closest to the Froude target, then the cheapest. A checkpoint beside the folder
+alone crowds into one region). The chosen point is a feasible Pareto point that passes every
+criterion of its gait, as ``validate`` judges it, when any does (the objectives do not score
+every criterion: a hop's stride regularity, for one), then the most robust (fewest failed
+perturbation trials), then the one closest to the Froude target, then the cheapest. A checkpoint beside the folder
 lets an interrupted run resume (the same command again); a run that ends removes it.
 """
 from __future__ import annotations
@@ -34,7 +36,8 @@ from cpgbiped.envs.search.physics_search import (FROUDE_TARGET, I_APP_BOUNDS, OB
                              initial_population, paper_point, trial_failed)
 
 METRICS = ("froude", "speed_mps", "cost_of_transport", "work_per_stride_J", "duty", "flight",
-           "stride_period_s", "apex_height_m", "physical_gait", "cpg_gait", "fell")
+           "stride_period_s", "apex_height_m", "physical_gait", "cpg_gait", "fell",
+           "passes_criteria")
 
 
 def checkpoint_name(gait: str) -> str:
@@ -53,10 +56,15 @@ def _point(gait, x, f, g, results) -> dict:
 
 
 def choose(points: list[dict]) -> int:
-    """Index of the chosen point among feasible points: fewest failed perturbation trials, then
-    the smallest Froude error, then the smallest cost."""
-    key = lambda k: tuple(points[k]["objectives"][n] for n in  # noqa: E731
-                          ("failed_fraction", "froude_error", "cost"))
+    """Index of the chosen point among feasible points: one whose unperturbed rollout passes
+    every criterion of its gait (``metrics.passes_criteria``; any point when none does), then
+    the fewest failed perturbation trials, then the smallest Froude error, then the smallest
+    cost. The search's objectives score speed, cost and survival, not every criterion (a hop's
+    stride regularity, for one): a point can be on the front and fail ``validate``."""
+    def key(k):
+        p = points[k]
+        fails = not p.get("metrics", {}).get("passes_criteria", True)
+        return (fails, *(p["objectives"][n] for n in ("failed_fraction", "froude_error", "cost")))
     return min(range(len(points)), key=key)
 
 

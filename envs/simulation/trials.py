@@ -26,7 +26,7 @@ import numpy as np
 
 from cpgbiped.cpg.errors import InputError
 
-from cpgbiped.envs.gaits.criteria import SETTLE_S
+from cpgbiped.envs.gaits.criteria import CRITERIA, SETTLE_S
 
 
 @dataclass(frozen=True)
@@ -69,6 +69,10 @@ class TrialResult:
     apex_height_m: float
     error: str | None = None
     cpg_gait: str | None = None  # the CPG classifier's gait from the cells (every producer sets it)
+    # Every criterion of the trial's gait met (envs.gaits.criteria: no fall, both classifiers,
+    # the pattern and the quality targets; not the comparisons with other gaits), as
+    # ``cpgbiped validate`` judges it; None where not measured.
+    passes_criteria: bool | None = None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -111,6 +115,8 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
     v = measure_recording(net, None, rec, settle_s)
     m, b = v.metrics, v.biomech
     fell = bool(m.fell) or rec.unstable is not None
+    passes = (trial.preset in CRITERIA and not fell
+              and not CRITERIA[trial.preset].failures(v.summary()))
     survived = float(rec.t[-1]) if len(rec.t) else 0.0
     return TrialResult(
         fell=fell, survived_s=survived if fell else total, physical_gait=m.physical_gait,
@@ -118,7 +124,8 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         cost_of_transport=_num(b.cost_of_transport), work_per_stride_J=_num(b.work_per_stride_J),
         duty=mean_finite([m.duty_factor["left"], m.duty_factor["right"]]),
         flight=_num(m.flight), stride_period_s=_num(m.stride_period_s),
-        apex_height_m=_num(b.apex_height_m), error=rec.unstable, cpg_gait=v.cpg_gait)
+        apex_height_m=_num(b.apex_height_m), error=rec.unstable, cpg_gait=v.cpg_gait,
+        passes_criteria=bool(passes))
 
 
 @dataclass(frozen=True)
