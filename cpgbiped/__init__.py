@@ -42,14 +42,16 @@ def _kernel_dirs() -> list:
             if _os.path.isfile(_os.path.join(base, sub, "__init__.py"))]
 
 
-def _numba_cache_dir() -> str:
+def _numba_cache_dir(prune: bool = False) -> str:
     """Where numba keeps the compiled kernels (``@njit(cache=True)``): a directory named by a
     hash of the package's sources. numba keys each cached function on its own file's time stamp
     only, so a kernel that inlines another module's function (envs/control/control_kernel.py's
     tick calls cpg/feedback.py's ``inputs``) or reads its constants would keep running the old
     code after that module changed (measured in session 52: a new feedback form ran as another
     form until the caches were deleted). A changed source gives a fresh directory, under the
-    user's cache folder, or the temporary folder when that cannot be written."""
+    user's cache folder, or the temporary folder when that cannot be written. ``prune``: also
+    mark the directory as used and remove stale ones (:func:`_prune_stale`; the user's cache
+    only), as the import does."""
     import tempfile
 
     name = _os.path.join("cpgbiped", "numba", _source_hash(_kernel_dirs()))
@@ -59,7 +61,8 @@ def _numba_cache_dir() -> str:
         try:
             _os.makedirs(path, exist_ok=True)
             if _os.access(path, _os.W_OK):
-                _prune_stale(path)
+                if prune:  # the user's own cache; the shared temporary folder is left alone
+                    _prune_stale(path)
                 return path
         except OSError:
             pass
@@ -70,30 +73,38 @@ STALE_CACHE_DAYS = 30  # a hash directory no import has used for this long is re
 
 
 def _prune_stale(path: str, days: float = STALE_CACHE_DAYS) -> None:
-    """Mark ``path`` (a hash directory of :func:`_numba_cache_dir`) as used now, and remove its
-    siblings that no import has marked for ``days``: each source edit leaves the old kernels
-    behind (a few MB), and another checkout's directory stays as long as it is in use. Only
-    names of 16 hex digits (this package's) are touched; errors are ignored."""
+    """Mark ``path`` (a hash directory of :func:`_numba_cache_dir` under the user's cache) as
+    used now, and remove its siblings that no import has marked for ``days``: each source edit
+    leaves the old kernels behind (a few MB), and another checkout's directory stays as long as
+    it is in use. Only names of 16 hex digits (this package's) are touched. A stale directory is
+    first renamed out of the way (one atomic step, so that a process that marks it again at the
+    same moment either finds it gone and compiles afresh, or keeps it), then deleted. Errors are
+    ignored: the cache is an optimisation."""
     import shutil
     import string
     import time
 
-    _os.utime(path)
-    parent = _os.path.dirname(path)
-    too_old = time.time() - days * 86400.0
     try:
+        _os.utime(path)
+        parent = _os.path.dirname(path)
         names = _os.listdir(parent)
     except OSError:
         return
+    too_old = time.time() - days * 86400.0
     for name in names:
         other = _os.path.join(parent, name)
-        if (len(name) == 16 and set(name) <= set(string.hexdigits.lower()) and other != path
-                and _os.path.isdir(other) and not _os.path.islink(other)):
-            try:
-                if _os.stat(other).st_mtime < too_old:
-                    shutil.rmtree(other, ignore_errors=True)
-            except OSError:
-                pass
+        if not (len(name) == 16 and set(name) <= set(string.hexdigits.lower())
+                and other != path):
+            continue
+        try:
+            if (_os.path.islink(other) or not _os.path.isdir(other)
+                    or _os.stat(other).st_mtime >= too_old):
+                continue
+            doomed = f"{other}.stale-{_os.getpid()}"
+            _os.rename(other, doomed)
+        except OSError:
+            continue
+        shutil.rmtree(doomed, ignore_errors=True)
 
 
 def _use_numba_cache_dir() -> None:
@@ -107,7 +118,7 @@ def _use_numba_cache_dir() -> None:
         return
     if not _kernel_dirs():
         return
-    path = _numba_cache_dir()
+    path = _numba_cache_dir(prune=True)
     _os.environ["NUMBA_CACHE_DIR"] = _os.environ["CPGBIPED_NUMBA_CACHE_DIR"] = path
     if "numba" in sys.modules:  # numba read its configuration already
         sys.modules["numba"].config.CACHE_DIR = path

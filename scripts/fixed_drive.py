@@ -16,7 +16,7 @@ them (envs.search.controller_tuning.hand_values: ``alternating.theta0=0.1``, a c
 ``startup.alternating.theta0=0.1``, a start-up corner's; ``ankle_gain=0.35``, a shared one): a
 probe, never written anywhere. --copy alternating=alternating_coactive: every gain of corner TO
 (and of its start-up corner) set to corner FROM's, before --set. Session 45 measured with it why
-the walk slows as the sweep's drive rises (README, "Transitions and drive sweeps").
+the walk slows as the sweep's drive rises (docs/RESULTS.md, "Why the walk slows as the drive rises").
 """
 import argparse
 from concurrent.futures import ProcessPoolExecutor

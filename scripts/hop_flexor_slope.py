@@ -4,7 +4,7 @@ A body experiment (2026-12-04; not adopted): the ankle flexor's force-length slo
 (models/biped/biped.xml, ``gainprm="60 -150 0"``: torque 60 - 150 q N m per unit of activation,
 zero at q = 0.4 rad of dorsiflexion) set to -100 or -60 in a copy of the model, and the presets
 rolled out with the committed gains ("base") and with a high-hop variant of the hop corner
-("high": knee_ext -0.1, kp_knee 1.0, k_av 3, k_ax 0; README, Status, "Hop"), from tuning CPG
+("high": knee_ext -0.1, kp_knee 1.0, k_av 3, k_ax 0; docs/JOURNAL.md, "Hop"), from tuning CPG
 states only (seeds 1000 and up), 20 s after settling:
 
     python scripts/hop_flexor_slope.py [--slopes -150,-100,-60] [--variants base,high]

@@ -125,13 +125,21 @@ def test_numba_caches_live_in_a_directory_named_by_the_sources(tmp_path):
         (d / "k" / "kernel.nbi").write_text("")
         old = time.time() - days * 86400
         os.utime(d, (old, old))
+    # an old directory reached through a link with a hash-like name: neither followed nor removed
+    target = tmp_path / "elsewhere"
+    (target / "k").mkdir(parents=True)
+    link = hashes / "aaaaaaaaaaaaaaaa"
+    link.symlink_to(target, target_is_directory=True)
+    os.utime(target, (time.time() - 90 * 86400,) * 2)
     for imports in ("import numba, cpgbiped", "import cpgbiped, numba"):  # numba first, or after
         out = subprocess.run([sys.executable, "-c", f"{imports}; {check}"], capture_output=True,
                              text=True, env=env, cwd=tmp_path, check=True)
         assert out.stdout.split() == ["True", "True", "True"], out.stderr
     assert not stale.exists() and recent.is_dir() and other.is_dir()
+    assert link.is_symlink() and (target / "k").is_dir()
+    assert not list(hashes.glob("*.stale-*"))  # the renamed stale directory is gone too
     # the directory in use is marked at each import, so an old one in use is never removed
-    ours = next(d for d in hashes.iterdir() if d not in (recent, other))
+    ours = next(d for d in hashes.iterdir() if d not in (recent, other, link))
     os.utime(ours, (time.time() - 90 * 86400,) * 2)
     subprocess.run([sys.executable, "-c", "import cpgbiped"], env=env, cwd=tmp_path, check=True)
     assert ours.is_dir() and time.time() - ours.stat().st_mtime < 3600

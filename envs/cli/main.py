@@ -430,7 +430,7 @@ def cmd_optimize_physics(a) -> int:
         f"phi {q['phi']:.3f}: Fr {q['metrics']['froude']:.4f}, cost {q['objectives']['cost']:.3f}, "
         f"failed {q['objectives']['failed_fraction']:.2f}, {q['metrics']['physical_gait']}"
         f"{', fell' if q['metrics']['fell'] else ''}"
-        f"{'' if q['metrics'].get('passes_criteria') else ', misses a criterion'}")
+        f"{'' if q['metrics'].get('passes_criteria') else ', not passing every criterion'}")
     n_pass = sum(bool(q["metrics"].get("passes_criteria")) for q in r["pareto"])
     print(f"{gait} in physics (Froude target {settings.froude:g}): {f['n_points']} Pareto points "
           f"({n_pass} passing every criterion of the {gait}), "

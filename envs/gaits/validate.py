@@ -35,7 +35,10 @@ class Validation:
     ankle_drive: bool = True
     biomech: Biomechanics | None = None
 
-    def summary(self) -> dict:
+    def summary(self, cpg_period: bool = True) -> dict:
+        """The measurements, the verdict (``failures``, ``passed``) against ``gait``'s criteria,
+        and the network's own period; ``cpg_period=False`` leaves that period out (None): it
+        integrates the network alone for 30 s, and no criterion reads it."""
         m = self.metrics
         s = {
             "network": self.network.kind, "preset": self.network.preset, "gait": self.gait,
@@ -44,7 +47,7 @@ class Validation:
             "unstable": self.recording.unstable,
             "duty_factor": m.duty_factor, "lr_phase_lag": m.lr_phase_lag,
             "double_support": m.double_support, "flight": m.flight,
-            "stride_period_s": m.stride_period_s, "cpg_period_s": _cpg_period_s(self.network),
+            "stride_period_s": m.stride_period_s, "cpg_period_s": _cpg_period_s(self.network) if cpg_period else None,
             "distance_m": m.distance_m, "speed_mps": m.speed_mps,
             "footfalls_per_stride": m.footfalls_per_stride,
             "ankle_excursion_deg": m.ankle_excursion_deg,

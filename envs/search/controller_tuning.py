@@ -169,7 +169,7 @@ SLIPPERY = tuple((1052 + k, 0.4) for k in range(4)) + tuple((1056 + k, 0.6) for 
 # robustness push) at 12.3 and 12.8 s, both ways, from CPG seeds 1060-1063, never a test's. Every
 # push before them comes at 4.5-6.8 s, while the run still accelerates (1.43 m/s over 5-8 s,
 # 1.55 settled); pushed once settled, the committed run fell in 29-30 of 30 census states
-# (docs/RESULTS.md, "Pushed once settled"). A rollout must last HELD_PUSH_MARGIN_S past the push's end
+# (docs/JOURNAL.md, "Pushed once settled"). A rollout must last HELD_PUSH_MARGIN_S past the push's end
 # (--seconds 12 with condition 40; 16 leaves the body 3 s to fall, as the searches used).
 HELD_PUSH_MARGIN_S = 1.0  # a held push's condition needs this long after the push ends
 SETTLED_PUSHES = ((1060, (12.3, 5.0, 0.2)), (1061, (12.3, -5.0, 0.2)),

@@ -63,7 +63,7 @@ def choose(points: list[dict]) -> int:
     stride regularity, for one): a point can be on the front and fail ``validate``."""
     def key(k):
         p = points[k]
-        fails = not p.get("metrics", {}).get("passes_criteria", True)
+        fails = not p.get("metrics", {}).get("passes_criteria")  # missing or None: not known to pass
         return (fails, *(p["objectives"][n] for n in ("failed_fraction", "froude_error", "cost")))
     return min(range(len(points)), key=key)
 
@@ -129,7 +129,7 @@ def _optimize(rd, ckpt, gait, rs, settings, runner, progress, stop_after) -> dic
         "wall_s": round(time.perf_counter() - t0, 3),
     }
     head = [*VARIABLES, *OBJECTIVES, "constraint", "froude", "speed_mps", "cost_of_transport",
-            "duty", "flight", "physical_gait", "cpg_gait", "fell"]
+            "duty", "flight", "physical_gait", "cpg_gait", "fell", "passes_criteria"]
     rows = lambda X, F, G, T: [  # noqa: E731
         [*np.round(x, 6), *np.round(f, 6), round(float(g), 6),
          *[t[0].as_dict()[c] for c in head[len(VARIABLES) + len(OBJECTIVES) + 1:]]]

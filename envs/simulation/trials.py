@@ -70,8 +70,9 @@ class TrialResult:
     error: str | None = None
     cpg_gait: str | None = None  # the CPG classifier's gait from the cells (every producer sets it)
     # Every criterion of the trial's gait met (envs.gaits.criteria: no fall, both classifiers,
-    # the pattern and the quality targets; not the comparisons with other gaits), as
-    # ``cpgbiped validate`` judges it; None where not measured.
+    # the pattern and the quality targets; not the comparisons with other gaits, such as the
+    # hop's cadence above the jump's), as ``cpgbiped validate`` judges it; None for a preset
+    # without criteria.
     passes_criteria: bool | None = None
 
     def as_dict(self) -> dict:
@@ -89,7 +90,7 @@ def quiet_worker() -> None:
 def _failed(why: str) -> TrialResult:
     nan = float("nan")
     return TrialResult(True, 0.0, "none", nan, nan, nan, nan, nan, nan, nan, nan, why,
-                       cpg_gait="none")
+                       cpg_gait="none", passes_criteria=False)
 
 
 def _num(x) -> float:
@@ -115,8 +116,8 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
     v = measure_recording(net, None, rec, settle_s)
     m, b = v.metrics, v.biomech
     fell = bool(m.fell) or rec.unstable is not None
-    passes = (trial.preset in CRITERIA and not fell
-              and not CRITERIA[trial.preset].failures(v.summary()))
+    passes = None if trial.preset not in CRITERIA else (
+        not fell and not CRITERIA[trial.preset].failures(v.summary(cpg_period=False)))
     survived = float(rec.t[-1]) if len(rec.t) else 0.0
     return TrialResult(
         fell=fell, survived_s=survived if fell else total, physical_gait=m.physical_gait,
@@ -125,7 +126,7 @@ def run_trial(trial: Trial, seconds: float, settle_s: float = SETTLE_S,
         duty=mean_finite([m.duty_factor["left"], m.duty_factor["right"]]),
         flight=_num(m.flight), stride_period_s=_num(m.stride_period_s),
         apex_height_m=_num(b.apex_height_m), error=rec.unstable, cpg_gait=v.cpg_gait,
-        passes_criteria=bool(passes))
+        passes_criteria=passes)
 
 
 @dataclass(frozen=True)
