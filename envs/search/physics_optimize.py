@@ -13,8 +13,9 @@ The Pareto set is taken over every point evaluated during the search (the final 
 alone crowds into one region). The chosen point is a feasible Pareto point that passes every
 criterion of its gait, as ``validate`` judges it, when any does (the objectives do not score
 every criterion: a hop's stride regularity, for one), then the most robust (fewest failed
-perturbation trials), then the one closest to the Froude target, then the cheapest. A checkpoint beside the folder
-lets an interrupted run resume (the same command again); a run that ends removes it.
+perturbation trials), then the one closest to the Froude target, then the cheapest. A
+checkpoint beside the folder lets an interrupted run resume (the same command again); a run
+that ends removes it.
 """
 from __future__ import annotations
 
@@ -63,7 +64,7 @@ def choose(points: list[dict]) -> int:
     stride regularity, for one): a point can be on the front and fail ``validate``."""
     def key(k):
         p = points[k]
-        fails = not p.get("metrics", {}).get("passes_criteria")  # missing or None: not known to pass
+        fails = not p.get("metrics", {}).get("passes_criteria")  # missing or None: not known
         return (fails, *(p["objectives"][n] for n in ("failed_fraction", "froude_error", "cost")))
     return min(range(len(points)), key=key)
 
